@@ -1,0 +1,3 @@
+from seminspect.cli import main
+
+main()

@@ -1,0 +1,8 @@
+"""Consoles shared by the command groups."""
+
+from __future__ import annotations
+
+from rich.console import Console
+
+console = Console()
+err_console = Console(stderr=True)

@@ -1,0 +1,146 @@
+"""Atomic file writes and versioned JSON documents.
+
+Every file seminspect writes goes through :func:`atomic_write_bytes`: the data lands in a
+temporary file in the same directory, is flushed to disk and then renamed over the target, so a
+crash or Ctrl-C leaves either the old file or the new one, never a torn one.
+
+Versioned JSON documents carry a small envelope ``{"format": KIND, "version": N, ...}`` so that a
+reader can refuse a file of another kind or a version it does not understand with a clear message.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+import os
+import tempfile
+from collections.abc import Callable, Iterable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from seminspect.core.errors import FileFormatError
+
+#: Refuse JSON documents larger than this; a scene graph of 10,000 inspected targets is ~200 MB.
+MAX_JSON_BYTES = 1 << 30
+
+
+def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> Path:
+    """Write ``data`` to ``path`` atomically (temporary file + fsync + rename)."""
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    try:
+        with os.fdopen(fd, "wb") as handle:
+            handle.write(data)
+            handle.flush()
+            os.fsync(handle.fileno())
+        Path(tmp_name).replace(target)
+    except BaseException:
+        Path(tmp_name).unlink(missing_ok=True)
+        raise
+    return target
+
+
+def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
+    """Write UTF-8 ``text`` to ``path`` atomically."""
+    return atomic_write_bytes(path, text.encode("utf-8"))
+
+
+def atomic_write_with(path: str | os.PathLike[str], write: Callable[[io.BytesIO], Any]) -> Path:
+    """Atomically write whatever ``write(buffer)`` puts into an in-memory buffer (figures, npz)."""
+    buffer = io.BytesIO()
+    write(buffer)
+    return atomic_write_bytes(path, buffer.getvalue())
+
+
+def save_npz_atomic(path: str | os.PathLike[str], **arrays: np.ndarray) -> Path:
+    """``numpy.savez_compressed`` with an atomic rename."""
+    return atomic_write_with(path, lambda buf: np.savez_compressed(buf, **arrays))
+
+
+def _json_default(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, Path):
+        return str(value)
+    raise TypeError(f"cannot serialise {type(value).__name__} to JSON")
+
+
+def dumps_json(document: Any, indent: int | None = None) -> str:
+    """Serialise to strict JSON (NaN and infinity are refused: they are not JSON)."""
+    return json.dumps(document, default=_json_default, indent=indent, allow_nan=False)
+
+
+def write_versioned_json(
+    path: str | os.PathLike[str],
+    kind: str,
+    version: int,
+    payload: dict[str, Any],
+    indent: int | None = None,
+) -> Path:
+    """Atomically write ``payload`` inside a ``{"format", "version"}`` envelope."""
+    document = {"format": kind, "version": version, **payload}
+    return atomic_write_text(path, dumps_json(document, indent=indent) + "\n")
+
+
+def _reject_constant(token: str) -> float:
+    raise ValueError(f"non-standard JSON constant {token}")
+
+
+def read_json(path: str | os.PathLike[str], max_bytes: int = MAX_JSON_BYTES) -> Any:
+    """Read a JSON file, turning every way it can be broken into a :class:`FileFormatError`."""
+    source = Path(path)
+    try:
+        size = source.stat().st_size
+    except FileNotFoundError:
+        raise FileFormatError(f"{source}: no such file") from None
+    except OSError as exc:
+        raise FileFormatError(f"{source}: cannot read ({exc.strerror})") from None
+    if source.is_dir():
+        raise FileFormatError(f"{source}: is a directory, expected a JSON file")
+    if size > max_bytes:
+        raise FileFormatError(f"{source}: {size} bytes is larger than the {max_bytes}-byte limit")
+    try:
+        text = source.read_text(encoding="utf-8")
+        return json.loads(text, parse_constant=_reject_constant)
+    except UnicodeDecodeError:
+        raise FileFormatError(f"{source}: not UTF-8 text (is it a binary file?)") from None
+    except json.JSONDecodeError as exc:
+        raise FileFormatError(
+            f"{source}: malformed JSON at line {exc.lineno} column {exc.colno}: {exc.msg}"
+        ) from None
+    except RecursionError:
+        raise FileFormatError(f"{source}: JSON nested too deeply") from None
+    except ValueError as exc:
+        raise FileFormatError(f"{source}: {exc}") from None
+    except OSError as exc:
+        raise FileFormatError(f"{source}: cannot read ({exc.strerror})") from None
+
+
+def read_versioned_json(
+    path: str | os.PathLike[str], kind: str, versions: Iterable[int]
+) -> dict[str, Any]:
+    """Read a document written by :func:`write_versioned_json`, checking its kind and version."""
+    supported = sorted(set(versions))
+    document = read_json(path)
+    if not isinstance(document, dict):
+        raise FileFormatError(f"{path}: expected a JSON object, found {type(document).__name__}")
+    found_kind = document.get("format")
+    if found_kind != kind:
+        raise FileFormatError(f"{path}: expected a {kind!r} file, found format {found_kind!r}")
+    found_version = document.get("version")
+    if found_version not in supported:
+        raise FileFormatError(
+            f"{path}: {kind} version {found_version!r} is not supported (supported: {supported})"
+        )
+    return document
+
+
+def finite_or_none(value: float) -> float | None:
+    """Map NaN and infinity to ``None`` for JSON output."""
+    return value if math.isfinite(value) else None

@@ -1,0 +1,1 @@
+"""Pure geometry: poses, rotations, validation of metric inputs. No I/O, no state."""

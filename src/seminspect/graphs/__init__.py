@@ -1,0 +1,1 @@
+"""Scene graphs: the 3D Layered Semantic Graph (``lsg``) and outdoor task graphs (``terrain``)."""

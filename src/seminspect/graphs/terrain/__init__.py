@@ -1,0 +1,1 @@
+"""Terrain-aware, task-driven outdoor scene graphs (001 Sec III)."""

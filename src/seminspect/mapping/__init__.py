@@ -1,0 +1,1 @@
+"""Metric maps: voxel occupancy (free / occupied / unknown) and metric-semantic point clouds."""

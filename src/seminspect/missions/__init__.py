@@ -1,0 +1,1 @@
+"""Missions: the xFLIE explore-inspect-explore executive and its run directory."""

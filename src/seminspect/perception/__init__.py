@@ -1,0 +1,1 @@
+"""Perception: from sensor frames to semantic observations (detection, localisation, similarity)."""

@@ -1,0 +1,1 @@
+"""Reports: pictures and tables made from graphs, worlds and run directories."""

@@ -1,0 +1,1 @@
+"""The simulated holonomic robot: ground and aerial modes, limits, collisions, trajectory log."""

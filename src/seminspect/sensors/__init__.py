@@ -1,0 +1,1 @@
+"""Simulated sensors: ray-cast depth + segmentation camera, intensity image, LiDAR, noise models."""

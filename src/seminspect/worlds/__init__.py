@@ -1,0 +1,1 @@
+"""Labelled triangle-mesh worlds (instance / class / part per face), generators and user worlds."""
