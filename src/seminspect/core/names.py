@@ -17,8 +17,13 @@ def closest_names(name: str, candidates: Iterable[str], limit: int = 5) -> list[
     return [by_lower[m] for m in matches]
 
 
-def unknown_name(kind: str, name: str, candidates: Iterable[str]) -> UnknownNameError:
-    """Build an :class:`UnknownNameError` that names the closest valid choices."""
+def unknown_name(
+    kind: str, name: str, candidates: Iterable[str], where: str = ""
+) -> UnknownNameError:
+    """Build an :class:`UnknownNameError` that names the closest valid choices.
+
+    ``where`` qualifies the scope: ``unknown feature 'hod-1' in Level-0 of car-1``.
+    """
     pool = sorted(set(candidates))
     suggestions = closest_names(name, pool)
     if suggestions:
@@ -28,4 +33,5 @@ def unknown_name(kind: str, name: str, candidates: Iterable[str]) -> UnknownName
         hint = f"valid names: {shown}"
     else:
         hint = f"there are no {kind}s"
-    return UnknownNameError(f"unknown {kind} {name!r}; {hint}")
+    scope = f" {where}" if where else ""
+    return UnknownNameError(f"unknown {kind} {name!r}{scope}; {hint}")

@@ -43,7 +43,7 @@ from seminspect.graphs.lsg.model import (
     TargetStatus,
 )
 from seminspect.planning.query import Query, Verb, parse_query, resolve_query
-from seminspect.planning.search import CsrGraph, shortest_path
+from seminspect.planning.search import CsrGraph, shortest_path, warm_up
 
 
 @dataclass(frozen=True, slots=True)
@@ -138,6 +138,7 @@ class HierarchicalPlanner:
         self.graph = graph
         self._network_cache: _Network | None = None
         self._local_cache: dict[str, _LocalIndex] = {}
+        warm_up()
 
     # ------------------------------------------------------------------ public API
     def query(self, text: str, start: ArrayLike | None = None) -> RoutePlan:

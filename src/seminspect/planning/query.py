@@ -124,7 +124,7 @@ def resolve_query(graph: LayeredSemanticGraph, query: Query) -> str:
     if query.level is not None:
         by_name = {lv.name.lower(): lv for lv in levels}
         if query.level not in by_name:
-            raise unknown_name(f"level of {target.id}", query.level, (lv.name for lv in levels))
+            raise unknown_name("level", query.level, (lv.name for lv in levels), f"of {target.id}")
         scope = [by_name[query.level]]
     else:
         scope = levels
@@ -137,8 +137,11 @@ def resolve_query(graph: LayeredSemanticGraph, query: Query) -> str:
         return matches[0].id
     where = f"{scope[0].name} of {target.id}" if query.level else target.id
     if not matches:
-        names = (node.name for level in scope for node in _named_nodes(level))
-        raise unknown_name(f"feature or pose in {where}", query.node, names)
+        nodes = [node for level in scope for node in _named_nodes(level)]
+        wanted = PoseNode if query.node.startswith("pose-") else FeatureNode
+        names = [node.name for node in nodes if isinstance(node, wanted)]
+        kind = "pose" if wanted is PoseNode else "feature"
+        raise unknown_name(kind, query.node, names, f"in {where}")
     places = ", ".join(node.id for node in matches)
     raise InvalidInputError(f"{query.node!r} is ambiguous in {where} ({places}); name the level")
 

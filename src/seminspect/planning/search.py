@@ -103,6 +103,12 @@ def _astar(indptr, indices, weights, coords, source, target, use_heuristic):  # 
     return cost[target], path, expanded
 
 
+def warm_up() -> None:
+    """Load (or compile) the kernel now, so that the first real query is not charged for it."""
+    tiny = CsrGraph.from_edges(np.zeros((2, 3)), [(0, 1)], [1.0])
+    shortest_path(tiny, 0, 1)
+
+
 def shortest_path(
     graph: CsrGraph, source: int, target: int, heuristic: bool = True
 ) -> tuple[float, NDArray[np.int64], int]:

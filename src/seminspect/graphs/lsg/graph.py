@@ -261,19 +261,17 @@ class LayeredSemanticGraph:
             reject_near_inspected=reject_near_inspected,
         )
         resolved: list[str | None] = [None] * len(candidates)
-        order = sorted(range(len(candidates)), key=lambda i: (-candidates[i].mask_area, i))
-        for i in order:  # the order eq (4) decided in, so merges find their node
-            decision = decisions[i]
+        for i, decision in enumerate(decisions):  # new nodes are numbered in registration order
             if decision.outcome is Outcome.ADDED:
                 resolved[i] = self._add_target(candidates[i]).id
-            elif decision.outcome is Outcome.MERGED:
-                into = (
-                    resolved[decision.into_candidate]
-                    if decision.into_candidate is not None
-                    else decision.target_id
-                )
-                assert into is not None
-                self._merge_detection(self._nodes[into], candidates[i])  # type: ignore[arg-type]
+        for i, decision in enumerate(decisions):
+            if decision.outcome is Outcome.MERGED:
+                into = decision.target_id
+                if decision.into_candidate is not None:
+                    into = resolved[decision.into_candidate]
+                target = self._nodes[into]  # type: ignore[index]
+                assert isinstance(target, TargetNode)
+                self._merge_detection(target, candidates[i])
                 resolved[i] = into
         if candidates:
             self.revision += 1
@@ -321,16 +319,16 @@ class LayeredSemanticGraph:
                 raise InvalidInputError(f"{node.id} is not inspected; only v_I - v_I edges exist")
         if first is second:
             raise InvalidInputError(f"cannot connect {first.id} to itself")
-        start, end = self.entry_level(first).position, self.entry_level(second).position
         inner = (
             np.empty((0, 3)) if via is None else np.asarray(via, dtype=np.float64).reshape(-1, 3)
         )
         if not np.all(np.isfinite(inner)):
             raise InvalidInputError("via points must be finite")
+        if first.id > second.id:  # orient along the canonical key, so the sum is reproducible
+            first, second, inner = second, first, inner[::-1]
+        start, end = self.entry_level(first).position, self.entry_level(second).position
         polyline = np.vstack([start, inner, end])
         weight = float(np.linalg.norm(np.diff(polyline, axis=0), axis=1).sum())
-        if first.id > second.id:  # store the polyline oriented along the canonical key
-            inner = inner[::-1]
         edge = self._connect(
             self.target_graph,
             first,

@@ -3,8 +3,9 @@
 Numbering rules:
 
 * **Targets** are ``<label>-<k>``, where ``k`` is a zero-based counter over every target ever
-  added to the graph, across labels (``car-0``, ``car-1``, ``truck-4`` as in 000 Table 5). A
-  number is never reused, even after the target is merged away, so a name keeps meaning one thing.
+  added to the graph, across labels, in the order the detections were registered (``car-0``,
+  ``car-1``, ``truck-4`` as in 000 Table 5). Numbers are never reused, so a name keeps meaning
+  one thing for the life of the graph.
 * **Levels** are ``Level-<j>``, zero-based per target in the order they were inspected.
 * **Poses** are ``pose-<n>``, zero-based per level in the order they were visited.
 * **Features** are ``<label>-<m>``, one-based per label within a level (``hood-1``,

@@ -1,0 +1,85 @@
+import json
+import os
+import stat
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from seminspect.core.errors import FileFormatError
+from seminspect.core.io import (
+    atomic_output,
+    atomic_write_text,
+    read_json,
+    read_versioned_json,
+    save_npz_atomic,
+    write_versioned_json,
+)
+
+
+def test_versioned_round_trip(tmp_path: Path) -> None:
+    path = write_versioned_json(tmp_path / "a" / "doc.json", "kind", 2, {"x": [1.5, 2]})
+    doc = read_versioned_json(path, "kind", [1, 2])
+    assert doc == {"format": "kind", "version": 2, "x": [1.5, 2]}
+
+
+def test_written_files_get_ordinary_permissions(tmp_path: Path) -> None:
+    path = atomic_write_text(tmp_path / "f.txt", "hello")
+    mode = stat.S_IMODE(path.stat().st_mode)
+    umask = os.umask(0)
+    os.umask(umask)
+    assert mode == 0o666 & ~umask
+
+
+def test_failed_write_keeps_the_old_file(tmp_path: Path) -> None:
+    path = atomic_write_text(tmp_path / "f.json", '{"ok": 1}')
+    with pytest.raises(RuntimeError), atomic_output(path) as tmp:
+        tmp.write_text("half a fi")
+        raise RuntimeError("crash while writing")
+    assert read_json(path) == {"ok": 1}
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["f.json"]
+
+
+def test_nan_is_refused_when_writing(tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match="JSON compliant"):
+        write_versioned_json(tmp_path / "n.json", "kind", 1, {"x": float("nan")})
+    assert not (tmp_path / "n.json").exists()
+
+
+def test_npz_is_written_atomically(tmp_path: Path) -> None:
+    save_npz_atomic(tmp_path / "a.npz", points=np.arange(6.0).reshape(2, 3))
+    with np.load(tmp_path / "a.npz") as data:
+        assert data["points"].shape == (2, 3)
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        ('{"format": "kind", "version": 1, "x": [1, 2', "malformed JSON at line 1"),
+        ("[1, 2]", "expected a JSON object"),
+        ('{"format": "other", "version": 1}', "expected a 'kind' file"),
+        ('{"format": "kind", "version": 9}', "version 9 is not supported"),
+        ('{"format": "kind", "version": 1, "x": NaN}', "non-standard JSON constant NaN"),
+        ("[" * 100_000 + "]" * 100_000, "nested too deeply"),
+    ],
+)
+def test_broken_documents_give_one_clear_error(tmp_path: Path, content: str, message: str) -> None:
+    path = tmp_path / "doc.json"
+    path.write_text(content)
+    with pytest.raises(FileFormatError, match=message):
+        read_versioned_json(path, "kind", [1])
+
+
+def test_binary_missing_directory_and_oversized_files(tmp_path: Path) -> None:
+    binary = tmp_path / "b.json"
+    binary.write_bytes(b"\xff\xfe\x00garbage")
+    with pytest.raises(FileFormatError, match="not UTF-8"):
+        read_json(binary)
+    with pytest.raises(FileFormatError, match="no such file"):
+        read_json(tmp_path / "missing.json")
+    with pytest.raises(FileFormatError, match="is a directory"):
+        read_json(tmp_path)
+    big = tmp_path / "big.json"
+    big.write_text(json.dumps({"x": "y" * 2000}))
+    with pytest.raises(FileFormatError, match="larger than"):
+        read_json(big, max_bytes=1000)

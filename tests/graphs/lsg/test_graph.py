@@ -1,0 +1,156 @@
+"""Construction of the 3DLSG through its registration operators (000 Sec IV-V)."""
+
+import math
+from itertools import pairwise
+
+import numpy as np
+import pytest
+
+from seminspect.core.errors import InvalidInputError, UnknownNameError
+from seminspect.geometry.transforms import quat_from_yaw
+from seminspect.graphs.lsg.graph import LayeredSemanticGraph
+from seminspect.graphs.lsg.model import EdgeKind, Layer, TargetStatus
+from seminspect.graphs.lsg.optimisation import Outcome
+from seminspect.perception.observation import Observation
+
+RING = [(10, -3), (13, 0), (10, 3), (7, 0)]  # four view poses around a car at (10, 0)
+
+
+def small_graph() -> LayeredSemanticGraph:
+    graph = LayeredSemanticGraph(robot_position=[0, 0, 0.7])
+    graph.register_target(Observation([9.0, 0.4, 0.7], label="car", score=0.9, mask_area=5000))
+    graph.register_target(Observation([0.0, 20.0, 0.7], label="truck", score=0.8, mask_area=9000))
+    graph.optimise_targets()
+    graph.begin_inspection("car-0", Observation.view_pose([7.0, 0.0, 0.7]))
+    for i, (x, y) in enumerate(RING):
+        graph.register_pose(
+            Observation.view_pose([x, y, 0.7], quat_from_yaw(0.0), image=f"{i}.png")
+        )
+        if i == 1:
+            graph.register_feature(
+                Observation([11.8, 0.0, 0.8], label="hood", score=0.7, mask_area=900)
+            )
+            graph.register_feature(
+                Observation([12.2, 0.1, 0.5], label="front-bumper", score=0.6, mask_area=400)
+            )
+        if i == 2:
+            graph.register_feature(
+                Observation([11.5, 0.2, 0.8], label="hood", score=0.95, mask_area=2000)
+            )
+    graph.finish_inspection()
+    return graph
+
+
+def test_names_follow_the_numbering_rules() -> None:
+    graph = small_graph()
+    assert [t.id for t in graph.targets()] == ["car-0", "truck-1"]
+    car = graph.target("CAR-0")
+    assert [lv.id for lv in car.levels] == ["car-0/Level-0"]
+    assert [p.name for p in car.levels[0].poses] == ["pose-0", "pose-1", "pose-2", "pose-3"]
+    features = {f.id: f.pose_id for p in car.levels[0].poses for f in p.features}
+    assert features == {
+        "car-0/Level-0/front-bumper-1": "car-0/Level-0/pose-1",
+        "car-0/Level-0/hood-1": "car-0/Level-0/pose-2",  # the 0.95 observation won eq (10)
+    }
+
+
+def test_edges_follow_000_sec_iv() -> None:
+    graph = small_graph()
+    kinds = {(e.u, e.v): e.kind for e in graph.edges()}
+    assert kinds[("car-0", "robot")] is EdgeKind.SYMBOLIC
+    assert kinds[("robot", "truck-1")] is EdgeKind.SYMBOLIC
+    assert kinds[("car-0", "car-0/Level-0")] is EdgeKind.SYMBOLIC
+    level = "car-0/Level-0"
+    chain = [level, *(f"{level}/pose-{i}" for i in range(4)), level]  # closed through the level
+    for a, b in pairwise(chain):
+        edge = graph.edge(a, b)
+        assert edge is not None and edge.kind is EdgeKind.SPATIAL
+        assert edge.weight == pytest.approx(
+            np.linalg.norm(graph.node(a).position - graph.node(b).position)
+        )
+    assert graph.edge(f"{level}/pose-2", f"{level}/hood-1").kind is EdgeKind.SYMBOLIC
+
+
+def test_population_has_the_shape_of_table_3() -> None:
+    stats = small_graph().population()
+    assert (stats.target.nodes, stats.target.edges) == (3, 2)  # robot + 2 targets
+    assert (stats.level.nodes, stats.level.edges) == (2, 1)  # car-0 + Level-0
+    assert (stats.pose.nodes, stats.pose.edges) == (5, 5)  # Level-0 + 4 poses, closed ring
+    assert (stats.feature.nodes, stats.feature.edges) == (4, 2)  # two feature graphs
+    assert (stats.total.nodes, stats.total.edges) == (14, 10)
+    assert (stats.unified.nodes, stats.unified.edges) == (10, 10)
+    assert stats.reconciled_pct == pytest.approx(100 * 4 / 14)
+    assert (stats.targets_detected, stats.targets_inspected) == (2, 1)
+
+
+def test_inspection_builds_the_polygon_and_refines_the_position() -> None:
+    car = small_graph().target("car-0")
+    assert car.status is TargetStatus.INSPECTED
+    np.testing.assert_array_equal(car.polygon, np.array(RING, dtype=float))
+    np.testing.assert_allclose(car.position, [10.0, 0.0, 0.7])  # centroid; height kept
+
+
+def test_duplicates_and_detections_inside_inspected_targets_are_filtered() -> None:
+    graph = small_graph()
+    graph.update_robot([0, 0, 0.7], quat_from_yaw(0.0), stamp=1.0)
+    graph.register_target(Observation([10.5, 1.0, 0.7], label="car", score=0.9, mask_area=100))
+    graph.register_target(Observation([1.0, 21.0, 0.7], label="truck", score=0.9, mask_area=99999))
+    graph.register_target(Observation([30.0, 0.0, 0.7], label="car", score=0.9, mask_area=10))
+    update = graph.optimise_targets()
+    outcomes = [d.outcome for d in update.decisions]
+    assert outcomes == [Outcome.INSIDE_POLYGON, Outcome.MERGED, Outcome.ADDED]
+    assert update.resolved == (None, "truck-1", "car-2")
+    truck = graph.target("truck-1")
+    assert truck.observations == 2 and truck.mask_area == 99999  # the fuller view took over
+    np.testing.assert_allclose(truck.position, [1.0, 21.0, 0.7])
+
+
+def test_levels_chain_with_spatial_edges() -> None:
+    graph = LayeredSemanticGraph()
+    graph.register_target(Observation([5, 0, 1], label="building", score=1, mask_area=1))
+    graph.optimise_targets()
+    graph.begin_inspection("building-0", Observation.view_pose([0, 0, 1]))
+    graph.register_pose(Observation.view_pose([0, 1, 1]))
+    graph.begin_level(Observation.view_pose([0, 1, 4]))
+    graph.register_pose(Observation.view_pose([0, 2, 4]))
+    graph.finish_inspection()
+    edge = graph.edge("building-0/Level-0", "building-0/Level-1")
+    assert edge.kind is EdgeKind.SPATIAL and edge.weight == pytest.approx(math.sqrt(1 + 9))
+    assert graph.target("building-0").polygon is None  # two poses cannot enclose anything
+    assert [g.parent.id for g in graph.local_graphs(Layer.POSE)] == [
+        "building-0/Level-0",
+        "building-0/Level-1",
+    ]
+
+
+def test_misuse_gives_clear_errors() -> None:
+    graph = small_graph()
+    with pytest.raises(InvalidInputError, match="no inspection in progress"):
+        graph.register_pose(Observation.view_pose([0, 0, 0]))
+    with pytest.raises(InvalidInputError, match="already inspected"):
+        graph.begin_inspection("car-0", Observation.view_pose([0, 0, 0]))
+    with pytest.raises(UnknownNameError, match="truck-1"):
+        graph.target("truck-2")
+    with pytest.raises(InvalidInputError, match="not inspected"):
+        graph.connect_targets("car-0", "truck-1")
+    graph.begin_inspection("truck-1", Observation.view_pose([0, 17, 0.7]))
+    with pytest.raises(InvalidInputError, match="register a pose"):
+        graph.register_feature(Observation([0, 20, 1], label="hood", score=1, mask_area=1))
+    with pytest.raises(InvalidInputError, match="already inspecting"):
+        graph.begin_inspection("truck-1", Observation.view_pose([0, 0, 0]))
+    with pytest.raises(InvalidInputError, match="invalid semantic label"):
+        graph.register_target(Observation([0, 0, 0], label="a/b"))
+    with pytest.raises(InvalidInputError, match="robot position"):
+        graph.update_robot([0, float("nan"), 0], [0, 0, 0, 1], 0.0)
+
+
+def test_connect_targets_weighs_the_via_polyline() -> None:
+    graph = small_graph()
+    graph.begin_inspection("truck-1", Observation.view_pose([0.0, 17.0, 0.7]))
+    graph.register_pose(Observation.view_pose([3.0, 20.0, 0.7]))
+    graph.finish_inspection()
+    edge = graph.connect_targets("truck-1", "car-0", via=[[0.0, 0.0, 0.7]])
+    # Level-0 of truck-1 (0,17) -> (0,0) -> Level-0 of car-0 (7,0)
+    assert edge.weight == pytest.approx(17 + 7)
+    assert (edge.u, edge.v) == ("car-0", "truck-1")
+    np.testing.assert_allclose(edge.via, [[0.0, 0.0, 0.7]])
