@@ -13,9 +13,11 @@ import sys
 from collections.abc import Sequence
 
 import typer
+from pydantic import ValidationError
 
 from seminspect import __version__
 from seminspect.cli._common import err_console
+from seminspect.core.config import describe_validation_error
 from seminspect.core.errors import SeminspectError
 
 #: (module under seminspect.cli, group name, one-line help)
@@ -73,10 +75,13 @@ def main(argv: Sequence[str] | None = None) -> None:
     debug = "--debug" in args or os.environ.get("SEMINSPECT_DEBUG") == "1"
     try:
         app(args=args, prog_name="seminspect", standalone_mode=True)
-    except SeminspectError as exc:
+    except (SeminspectError, ValidationError) as exc:
         if debug:
             raise
-        err_console.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
+        message = (
+            describe_validation_error(exc, "value") if isinstance(exc, ValidationError) else exc
+        )
+        err_console.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
         raise SystemExit(1) from None
     except KeyboardInterrupt:
         err_console.print("interrupted", highlight=False)

@@ -8,11 +8,12 @@ scene-similarity settings; all of them read the same object so a run is describe
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from seminspect.core.errors import InvalidInputError
+from seminspect.core.config import build
 from seminspect.core.names import unknown_name
 
 PresetName = Literal["urban-simulated", "urban-experimental", "collapsed-buildings"]
@@ -61,14 +62,9 @@ class InspectionParams(BaseModel):
         return make_params(self.model_dump() | changes)
 
 
-def make_params(values: dict[str, float | int]) -> InspectionParams:
+def make_params(values: Mapping[str, float | int]) -> InspectionParams:
     """Validate raw values into :class:`InspectionParams`, with one readable error line."""
-    try:
-        return InspectionParams(**values)
-    except ValidationError as exc:
-        first = exc.errors()[0]
-        where = ".".join(str(part) for part in first["loc"]) or "parameters"
-        raise InvalidInputError(f"invalid inspection parameter {where}: {first['msg']}") from None
+    return build(InspectionParams, values, "inspection parameter")
 
 
 #: 000 Table 1 (urban, simulated and experimental) and Table 2 (collapsed buildings).
