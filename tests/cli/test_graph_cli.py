@@ -68,3 +68,9 @@ def test_export_formats(capsys, tmp_path: Path) -> None:
     assert load_graph(tmp_path / "g.json").population().targets_inspected == 5
     code, _, err = run(capsys, "graph", "export", str(tmp_path / "g.json"), "-f", "json")
     assert code != 0 and "overwrite" in err
+
+
+def test_show_draws_the_layers(capsys, tmp_path: Path) -> None:
+    out = tmp_path / "g.png"
+    code, _, _ = run(capsys, "graph", "show", "example", "--out", str(out), "-q", "Visit car-1")
+    assert code == 0 and out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

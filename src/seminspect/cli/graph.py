@@ -195,3 +195,24 @@ def export(
     }[fmt]
     writer(graph, target)
     console.print(f"wrote {target}")
+
+
+@app.command()
+def show(
+    graph_file: str = typer.Argument(..., metavar="FILE", help=GRAPH_HELP),
+    out: Path = typer.Option(
+        Path("graph.png"), "--out", "-o", help="Picture to write (png, svg, pdf)."
+    ),
+    query_text: str | None = typer.Option(
+        None, "--query", "-q", help="Also draw this query's route."
+    ),
+) -> None:
+    """Draw the graph's layers stacked above the ground, optionally with a query's route."""
+    from seminspect.planning.hierarchical import HierarchicalPlanner
+    from seminspect.report.figures import save_figure
+    from seminspect.report.lsg import draw_layers
+
+    graph = _load(graph_file)
+    plan = HierarchicalPlanner(graph).query(query_text) if query_text else None
+    save_figure(draw_layers(graph, plan=plan, title=query_text), out)
+    console.print(f"wrote {out}")
