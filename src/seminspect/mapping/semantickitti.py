@@ -1,0 +1,149 @@
+"""SemanticKITTI scans: ``.bin`` points, ``.label`` labels, ``poses.txt`` and ``calib.txt``.
+
+A scan is ``float32`` rows ``x y z remission`` in the Velodyne frame; its label file holds one
+``uint32`` per point, the semantic id in the lower 16 bits and the instance id in the upper 16.
+Semantic ids are named through the dataset's published label table (shipped as package data).
+Poses are KITTI odometry poses of the left camera (``cam0``), 3x4 row-major per line; with the
+calibration's ``Tr`` (Velodyne to cam0) the Velodyne pose of scan ``i`` in the frame of scan 0's
+Velodyne is ``inv(Tr) @ P_i @ Tr``.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from seminspect.core.errors import FileFormatError, InvalidInputError
+from seminspect.mapping.semantic_cloud import as_transform
+
+
+@dataclass(frozen=True)
+class LabelTable:
+    """SemanticKITTI's label table: raw id -> name, and raw id -> training class."""
+
+    names: dict[int, str]
+    learning_map: dict[int, int]
+
+
+@functools.cache
+def label_table() -> LabelTable:
+    """The published SemanticKITTI label table."""
+    text = resources.files("seminspect.mapping").joinpath("data/semantic_kitti_labels.json")
+    document = json.loads(text.read_text(encoding="utf-8"))
+    return LabelTable(
+        names={int(k): v for k, v in document["labels"].items()},
+        learning_map={int(k): int(v) for k, v in document["learning_map"].items()},
+    )
+
+
+@dataclass
+class KittiScan:
+    """One labelled scan in its sensor frame."""
+
+    points: NDArray[np.float64]
+    remission: NDArray[np.float32]
+    semantic: NDArray[np.int64] | None
+    instance: NDArray[np.int64] | None
+
+
+def read_scan(path: str | Path) -> tuple[NDArray[np.float64], NDArray[np.float32]]:
+    """Points ``(N, 3)`` and remission ``(N,)`` of a Velodyne ``.bin`` scan."""
+    source = Path(path)
+    if not source.is_file():
+        raise FileFormatError(f"{source}: no such file")
+    raw = source.read_bytes()
+    if len(raw) == 0 or len(raw) % 16:
+        raise FileFormatError(
+            f"{source}: {len(raw)} bytes is not a whole number of 16-byte points (x y z remission)"
+        )
+    rows = np.frombuffer(raw, dtype="<f4").reshape(-1, 4)
+    if not np.all(np.isfinite(rows[:, :3])):
+        raise FileFormatError(f"{source}: scan has NaN or infinite coordinates")
+    return rows[:, :3].astype(np.float64), rows[:, 3].copy()
+
+
+def read_labels(path: str | Path, points: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Semantic ids and instance ids of a ``.label`` file for a scan of ``points`` points."""
+    source = Path(path)
+    if not source.is_file():
+        raise FileFormatError(f"{source}: no such file")
+    raw = source.read_bytes()
+    if len(raw) != 4 * points:
+        raise FileFormatError(
+            f"{source}: {len(raw)} bytes of labels for a scan of {points} points "
+            f"(expected {4 * points})"
+        )
+    values = np.frombuffer(raw, dtype="<u4")
+    semantic = (values & 0xFFFF).astype(np.int64)
+    unknown = sorted(set(np.unique(semantic).tolist()) - set(label_table().names))
+    if unknown:
+        raise FileFormatError(f"{source}: semantic ids {unknown[:5]} are not in the label table")
+    return semantic, (values >> 16).astype(np.int64)
+
+
+def read_kitti_scan(scan: str | Path, labels: str | Path | None = None) -> KittiScan:
+    points, remission = read_scan(scan)
+    if labels is None:
+        return KittiScan(points, remission, None, None)
+    semantic, instance = read_labels(labels, points.shape[0])
+    return KittiScan(points, remission, semantic, instance)
+
+
+def read_calib(path: str | Path) -> dict[str, NDArray[np.float64]]:
+    """The 3x4 matrices of a KITTI ``calib.txt`` (``P0``..``P3``, ``Tr``) by name."""
+    source = Path(path)
+    if not source.is_file():
+        raise FileFormatError(f"{source}: no such file")
+    matrices = {}
+    for number, line in enumerate(source.read_text(encoding="utf-8").splitlines(), 1):
+        if not line.strip():
+            continue
+        key, sep, values = line.partition(":")
+        try:
+            matrix = np.array(values.split(), dtype=np.float64)
+        except ValueError:
+            matrix = np.zeros(0)
+        if not sep or matrix.size != 12 or not np.all(np.isfinite(matrix)):
+            raise FileFormatError(f"{source}: line {number} is not 'NAME: 12 numbers'")
+        matrices[key.strip()] = matrix.reshape(3, 4)
+    if "Tr" not in matrices:
+        raise FileFormatError(f"{source}: no Tr (Velodyne to camera) calibration")
+    return matrices
+
+
+def read_poses(path: str | Path) -> NDArray[np.float64]:
+    """KITTI odometry poses as ``(M, 4, 4)`` matrices (one 3x4 row-major pose per line)."""
+    source = Path(path)
+    if not source.is_file():
+        raise FileFormatError(f"{source}: no such file")
+    poses = []
+    for number, line in enumerate(source.read_text(encoding="utf-8").splitlines(), 1):
+        if not line.strip():
+            continue
+        try:
+            values = np.array(line.split(), dtype=np.float64)
+        except ValueError:
+            values = np.zeros(0)
+        if values.size != 12:
+            raise FileFormatError(f"{source}: line {number} is not 12 numbers (a 3x4 pose)")
+        pose = np.vstack([values.reshape(3, 4), [0.0, 0.0, 0.0, 1.0]])
+        try:
+            poses.append(as_transform(pose, f"pose on line {number}"))
+        except InvalidInputError as exc:
+            raise FileFormatError(f"{source}: {exc}") from None
+    if not poses:
+        raise FileFormatError(f"{source}: no poses")
+    return np.stack(poses)
+
+
+def velodyne_poses(camera_poses: NDArray[np.float64], Tr: NDArray[np.float64]) -> NDArray:
+    """Velodyne poses in the frame of the first scan's Velodyne: ``inv(Tr) @ P_i @ Tr``."""
+    tr = np.vstack([np.asarray(Tr, dtype=np.float64).reshape(3, 4), [0.0, 0.0, 0.0, 1.0]])
+    tr = as_transform(tr, "calibration Tr")
+    return np.linalg.inv(tr) @ camera_poses @ tr
