@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import functools
 import json
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -20,7 +21,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from seminspect.core.errors import FileFormatError, InvalidInputError
-from seminspect.mapping.semantic_cloud import as_transform
+from seminspect.mapping.ingest import integrate_labelled_scan
+from seminspect.mapping.semantic_cloud import SemanticCloud, as_transform, transform_points
+from seminspect.perception.encoders import Encoder
 
 
 @dataclass(frozen=True)
@@ -147,3 +150,84 @@ def velodyne_poses(camera_poses: NDArray[np.float64], Tr: NDArray[np.float64]) -
     tr = np.vstack([np.asarray(Tr, dtype=np.float64).reshape(3, 4), [0.0, 0.0, 0.0, 1.0]])
     tr = as_transform(tr, "calibration Tr")
     return np.linalg.inv(tr) @ camera_poses @ tr
+
+
+def instance_boxes(
+    points: NDArray[np.float64],
+    semantic: NDArray[np.int64],
+    instance: NDArray[np.int64],
+    learning_class: int,
+    min_points: int = 1,
+) -> list[tuple[NDArray[np.float64], NDArray[np.float64]]]:
+    """Axis-aligned boxes of the labelled instances of one training class.
+
+    Raw ids that share a training class (``car`` and ``moving-car``) count as one class; an
+    instance is a (training class, instance id) pair, consistent across a sequence's scans.
+    """
+    mapping = label_table().learning_map
+    ids = [raw for raw, cls in mapping.items() if cls == learning_class]
+    chosen = np.isin(semantic, ids) & (instance > 0)
+    boxes = []
+    for value in np.unique(instance[chosen]):
+        members = points[chosen & (instance == value)]
+        if members.shape[0] >= min_points:
+            boxes.append((members.min(axis=0), members.max(axis=0)))
+    return boxes
+
+
+@dataclass
+class FusedScans:
+    """Several posed, labelled scans fused into one cloud, with their labels in the world frame."""
+
+    cloud: SemanticCloud
+    points: NDArray[np.float64]
+    semantic: NDArray[np.int64]
+    instance: NDArray[np.int64]
+
+
+def frame_number(scan: str | Path) -> int:
+    """The frame index of a KITTI scan file name (``000042.bin`` -> 42)."""
+    stem = Path(scan).stem
+    if not stem.isdigit():
+        raise InvalidInputError(f"{scan}: KITTI scans are named by frame number, e.g. 000042.bin")
+    return int(stem)
+
+
+def fuse_kitti_scans(
+    scans: Sequence[tuple[Path, Path]],
+    poses: NDArray[np.float64] | None,
+    encoder: Encoder,
+    radius: float,
+    on_scan: Callable[[int], None] | None = None,
+) -> FusedScans:
+    """Fuse labelled scans, each one view, posed by frame number (001 Sec III-A.3).
+
+    ``poses`` are Velodyne poses (:func:`velodyne_poses`); without them only one scan may be
+    given and it stays in its own frame.
+    """
+    if poses is None and len(scans) != 1:
+        raise InvalidInputError("fusing several scans needs their poses (--poses and --calib)")
+    cloud = SemanticCloud.empty(encoder.dim, encoder.name)
+    names = label_table().names
+    world, semantic, instance = [], [], []
+    for k, (scan_path, label_path) in enumerate(scans):
+        scan = read_kitti_scan(scan_path, label_path)
+        pose = np.eye(4)
+        if poses is not None:
+            frame = frame_number(scan_path)
+            if frame >= poses.shape[0]:
+                raise InvalidInputError(
+                    f"{scan_path}: frame {frame} has no pose ({poses.shape[0]})"
+                )
+            pose = poses[frame]
+        integrate_labelled_scan(
+            cloud, scan.points, scan.semantic, pose, names=names, encoder=encoder, radius=radius
+        )
+        world.append(transform_points(pose, scan.points))
+        semantic.append(scan.semantic)
+        instance.append(scan.instance)
+        if on_scan:
+            on_scan(k)
+    return FusedScans(
+        cloud, np.concatenate(world), np.concatenate(semantic), np.concatenate(instance)
+    )
