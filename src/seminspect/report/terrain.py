@@ -61,6 +61,7 @@ def plot_classified_cloud(
     points: NDArray[np.float64],
     classes: NDArray[np.int64],
     prompts: TaskPrompts,
+    *,
     max_points: int = 250_000,
     seed: int = 0,
 ) -> Path:
@@ -132,13 +133,8 @@ def plot_place_layer(path: str | Path, build: TerrainBuild, max_points: int = 15
             style = "-" if data["kind"] == "gvd" else ":"
             ax.plot([pa[0], pb[0]], [pa[1], pb[1]], style, color="black", linewidth=0.8)
     for terrain in scene.prompts.terrain:
-        xy = np.array(
-            [
-                graph.nodes[n]["position"][:2]
-                for n in scene.nodes_of("place")
-                if graph.nodes[n]["terrain"] == terrain
-            ]  # fmt: skip
-        ).reshape(-1, 2)
+        mine = [n for n in scene.nodes_of("place") if graph.nodes[n]["terrain"] == terrain]
+        xy = np.array([graph.nodes[n]["position"][:2] for n in mine]).reshape(-1, 2)
         ax.scatter(xy[:, 0], xy[:, 1], s=28, c=colours[terrain], edgecolors="black", label=terrain)
     ax.set_aspect("equal")
     ax.set_title("Terrain-aware place nodes (dotted: links between terrain types)")
