@@ -25,13 +25,21 @@ from seminspect.mapping.ingest import integrate_labelled_scan
 from seminspect.mapping.semantic_cloud import SemanticCloud, as_transform, transform_points
 from seminspect.perception.encoders import Encoder
 
+#: Training classes 1-8 (car .. motorcyclist) are the instance-labelled "things".
+_THING_CLASSES = range(1, 9)
+
 
 @dataclass(frozen=True)
 class LabelTable:
-    """SemanticKITTI's label table: raw id -> name, and raw id -> training class."""
+    """SemanticKITTI's label table: raw id -> name, raw id -> training class and back."""
 
     names: dict[int, str]
     learning_map: dict[int, int]
+    learning_map_inv: dict[int, int]
+
+    def thing_classes(self) -> dict[int, str]:
+        """Training classes whose points carry instance ids (SemanticKITTI's "things", 1-8)."""
+        return {c: self.names[self.learning_map_inv[c]] for c in _THING_CLASSES}
 
 
 @functools.cache
@@ -42,6 +50,7 @@ def label_table() -> LabelTable:
     return LabelTable(
         names={int(k): v for k, v in document["labels"].items()},
         learning_map={int(k): int(v) for k, v in document["learning_map"].items()},
+        learning_map_inv={int(k): int(v) for k, v in document["learning_map_inv"].items()},
     )
 
 
