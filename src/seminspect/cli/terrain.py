@@ -11,7 +11,8 @@ from seminspect.cli._common import console
 
 app = typer.Typer(no_args_is_help=True, help="Terrain-aware, task-driven outdoor scene graphs.")
 
-_GRAPH_HELP = """Build the task-driven scene graph (001 Sec III-B) of a cloud or SemanticKITTI scans.
+_GRAPH_HELP = """Build the task-driven scene graph (001 Sec III-B) of a cloud or of SemanticKITTI scans.
+
 
 INPUT is a .ply/.pcd/.npz cloud with per-point embeddings or labels, a semantic cloud saved by
 seminspect, or SemanticKITTI .bin scans with --labels (one per scan, same order)."""
