@@ -56,7 +56,7 @@ class HashingTextEncoder:
         return np.asarray(rows, dtype=np.float32).reshape(len(rows), self.dim)
 
 
-@pytest.fixture
+@pytest.fixture(scope="session")
 def fake_encoder():
     """A caption encoder over :class:`HashingTextEncoder`, registered as ``hashing-test``."""
     from seminspect.perception.encoders import Calibration, CaptionEncoder, register_encoder
@@ -64,3 +64,28 @@ def fake_encoder():
     calibration = Calibration(terrain=0.45, objects=0.45, null_task=0.3)
     register_encoder("hashing-test", lambda: CaptionEncoder(HashingTextEncoder()), calibration)
     return CaptionEncoder(HashingTextEncoder())
+
+
+@pytest.fixture(scope="session")
+def labelled_scene():
+    """A small labelled outdoor scene: road, sidewalk, grass, three cars and two trees."""
+    import numpy as np
+
+    xs, ys = np.meshgrid(np.arange(0, 60, 0.3), np.arange(-10, 20, 0.3), indexing="ij")
+    ground = np.column_stack([xs.ravel(), ys.ravel(), np.zeros(xs.size)])
+    labels = np.where(ground[:, 1] < 0, 2, np.where(ground[:, 1] < 3, 0, 1))
+    rng = np.random.default_rng(7)
+    parts, part_labels = [ground], [labels]
+    for x0 in (8.0, 25.0, 45.0):  # cars on the road
+        car = rng.uniform([x0, -6.0, 0.2], [x0 + 4.2, -4.2, 1.6], (700, 3))
+        parts.append(car)
+        part_labels.append(np.full(700, 3))
+    for x0, y0 in ((15.0, 10.0), (40.0, 12.0)):  # tree trunks and crowns on the grass
+        angle = rng.uniform(0, 2 * np.pi, 500)
+        height = rng.uniform(0, 4, 500)
+        radius = np.where(height > 2, 0.8, 0.3)
+        tree = np.column_stack([x0 + radius * np.cos(angle), y0 + radius * np.sin(angle), height])
+        parts.append(tree)
+        part_labels.append(np.full(500, 4))
+    names = {0: "sidewalk", 1: "grass", 2: "road", 3: "car", 4: "tree"}
+    return np.vstack(parts), np.concatenate(part_labels), names

@@ -44,7 +44,9 @@ def test_embedding_is_the_mean_of_every_observation(views: list[list[int]]) -> N
     for row, point in enumerate(cloud.points):
         anchor = int(np.argmin(np.linalg.norm(anchors - point, axis=1)))
         assert cloud.counts[row] == len(observed[anchor])
-        np.testing.assert_allclose(cloud.embeddings[row], np.mean(observed[anchor], axis=0), atol=1e-5)
+        np.testing.assert_allclose(
+            cloud.embeddings[row], np.mean(observed[anchor], axis=0), atol=1e-5
+        )
 
 
 def _segmentation() -> CameraSegmentation:
@@ -73,7 +75,7 @@ def test_scan_points_take_the_segment_they_project_into() -> None:
     pose[:3, 3] = [100.0, 0.0, 0.0]
     stats = fuse_scan(cloud, points, pose, _segmentation(), radius=0.1)
     assert (stats.associated, stats.added) == (0, 2)
-    np.testing.assert_allclose(cloud.points, points[:2] + [100.0, 0, 0])
+    np.testing.assert_allclose(cloud.points, points[:2] + np.array([100.0, 0, 0]))
     np.testing.assert_allclose(cloud.embeddings, [[1.0, 0.0], [0.0, 1.0]])
 
 

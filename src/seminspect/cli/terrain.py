@@ -11,7 +11,7 @@ from seminspect.cli._common import console
 
 app = typer.Typer(no_args_is_help=True, help="Terrain-aware, task-driven outdoor scene graphs.")
 
-_GRAPH_HELP = """Build the task-driven scene graph (001 Sec III-B) of a cloud or of SemanticKITTI scans.
+_GRAPH_HELP = """Build the task-driven scene graph (001 Sec III-B) of a cloud or scans.
 
 
 INPUT is a .ply/.pcd/.npz cloud with per-point embeddings or labels, a semantic cloud saved by
