@@ -24,6 +24,7 @@ from seminspect.core.errors import SeminspectError
 #: Group modules import heavy dependencies inside their commands so ``--help`` stays fast.
 GROUPS: tuple[tuple[str, str, str], ...] = (
     ("graph", "graph", "Inspect, query and export 3D Layered Semantic Graphs."),
+    ("terrain", "terrain", "Terrain-aware, task-driven outdoor scene graphs (paper 001)."),
 )
 
 app = typer.Typer(

@@ -1,0 +1,241 @@
+"""``seminspect terrain``: task-driven terrain scene graphs from metric-semantic clouds (001)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import typer
+
+from seminspect.cli._common import console
+
+app = typer.Typer(no_args_is_help=True, help="Terrain-aware, task-driven outdoor scene graphs.")
+
+_GRAPH_HELP = """Build the task-driven scene graph (001 Sec III-B) of a cloud or scans.
+
+
+INPUT is a .ply/.pcd/.npz cloud with per-point embeddings or labels, a semantic cloud saved by
+seminspect, or SemanticKITTI .bin scans with --labels (one per scan, same order)."""
+
+
+def _param_overrides(items: list[str], cell_size: float | None) -> dict[str, Any]:
+    from seminspect.core.errors import InvalidInputError
+
+    values: dict[str, Any] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep:
+            raise InvalidInputError(f"--param takes NAME=VALUE, got {item!r}")
+        try:
+            values[key.strip()] = float(value) if "." in value or "e" in value else int(value)
+        except ValueError:
+            raise InvalidInputError(f"--param {key} needs a number, got {value!r}") from None
+    if cell_size is not None:
+        values["cell_size"] = cell_size
+    return values
+
+
+def _load_cloud(inputs: list[Path], labels: list[Path], options: dict[str, Any], encoder, progress):
+    """The phase-1 cloud, and fused KITTI labels when the input is scans (else ``None``)."""
+    from seminspect.core.errors import InvalidInputError
+    from seminspect.mapping.ingest import cloud_from_point_data
+    from seminspect.mapping.pointfiles import label_names_from_text, load_point_file
+    from seminspect.mapping.semantic_cloud import cloud_from_arrays, is_cloud_file, read_npz
+    from seminspect.mapping.semantickitti import (
+        fuse_kitti_scans,
+        read_calib,
+        read_poses,
+        velodyne_poses,
+    )
+
+    if all(path.suffix.lower() == ".bin" for path in inputs):
+        if len(labels) != len(inputs):
+            raise InvalidInputError("give one --labels file per SemanticKITTI scan")
+        poses = None
+        if options["poses"] is not None or options["calib"] is not None:
+            if options["poses"] is None or options["calib"] is None:
+                raise InvalidInputError("--poses and --calib go together")
+            tr = read_calib(options["calib"])["Tr"]
+            poses = velodyne_poses(read_poses(options["poses"]), tr)
+        task = progress.add_task("phase 1: fusing scans", total=len(inputs))
+        fused = fuse_kitti_scans(
+            list(zip(inputs, labels, strict=True)),
+            poses,
+            encoder,
+            options["radius"],
+            on_scan=lambda _: progress.advance(task),
+        )
+        return fused.cloud, fused
+    if len(inputs) != 1 or labels:
+        raise InvalidInputError("give one cloud file (several inputs and --labels are for scans)")
+    source = inputs[0]
+    if source.suffix.lower() == ".npz":
+        arrays = read_npz(source)
+        if is_cloud_file(arrays):
+            cloud = cloud_from_arrays(source, arrays)
+            if cloud.encoder != encoder.name:
+                raise InvalidInputError(
+                    f"{source} was embedded by {cloud.encoder!r}; pass --encoder {cloud.encoder}"
+                )
+            return cloud, None
+    names = label_names_from_text(options["label_names"]) if options["label_names"] else None
+    return cloud_from_point_data(load_point_file(source), encoder, names), None
+
+
+def _quality(build, fused, encoder) -> dict[str, Any]:
+    """Object precision/recall against the scans' own instance labels."""
+    import numpy as np
+
+    from seminspect.graphs.terrain.evaluate import match_boxes, predicted_boxes
+    from seminspect.mapping.semantickitti import instance_boxes, label_table
+    from seminspect.perception.encoders import caption
+
+    things = label_table().thing_classes()
+    classes = sorted(things)
+    captions = encoder.encode_text([caption(things[c]) for c in classes])
+    report: dict[str, Any] = {}
+    for prompt in build.scene.prompts.objects:
+        similarity = captions @ encoder.encode_text([prompt])[0]
+        best = int(np.argmax(similarity))
+        if similarity[best] < build.scene.calibration.objects:
+            report[prompt] = {"ground_truth_class": None}
+            continue
+        truth = instance_boxes(
+            fused.points, fused.semantic, fused.instance, classes[best], min_points=1
+        )
+        scores = match_boxes(predicted_boxes(build.scene, prompt), truth, threshold=0.3)
+        report[prompt] = {
+            "ground_truth_class": things[classes[best]],
+            "iou_threshold": scores.threshold,
+            "predicted": scores.predicted,
+            "ground_truth": scores.ground_truth,
+            "matched": scores.matched,
+            "precision": scores.precision,
+            "recall": scores.recall,
+            "mean_iou": scores.mean_iou,
+        }
+    return report
+
+
+def _write_outputs(out: Path, build, cloud, progress) -> None:
+    from seminspect.graphs.terrain.serialization import save_terrain_graph, write_graphml
+    from seminspect.report.terrain import (
+        plot_classified_cloud,
+        plot_gvd_stages,
+        plot_layered_graph,
+        plot_place_layer,
+    )
+
+    task = progress.add_task("writing graph and pictures", total=4 + len(build.places.gvd))
+    save_terrain_graph(out / "graph.json", build.scene, layer1_file="layer1.npz")
+    write_graphml(out / "graph.graphml", build.scene)
+    progress.advance(task)
+    plot_classified_cloud(out / "classified_cloud.png", cloud.points, build.cloud_classes,
+                          build.scene.prompts)  # fmt: skip
+    progress.advance(task)
+    for index, (terrain, gvd) in enumerate(build.places.gvd.items()):
+        plot_gvd_stages(out / f"gvd_{index}_{_slug(terrain)}.png", gvd, terrain)
+        progress.advance(task)
+    plot_place_layer(out / "places.png", build)
+    progress.advance(task)
+    plot_layered_graph(out / "layers.png", build)
+    progress.advance(task)
+
+
+def _slug(text: str) -> str:
+    return "".join(ch if ch.isalnum() else "_" for ch in text).strip("_") or "terrain"
+
+
+@app.command("graph", help=_GRAPH_HELP)
+def graph(
+    inputs: list[Path] = typer.Argument(..., help="Cloud file, or SemanticKITTI .bin scans."),
+    out: Path = typer.Option(..., "--out", help="Directory for the graph, summary and pictures."),
+    terrain: str = typer.Option("sidewalk,grass,asphalt", help="Terrain prompts, comma-separated."),
+    objects: str = typer.Option(
+        "image of a tree,image of a car", help="Object prompts, comma-separated."
+    ),
+    labels: list[Path] = typer.Option([], "--labels", help="SemanticKITTI .label, one per scan."),
+    poses: Path | None = typer.Option(None, help="KITTI poses.txt (fuses several scans)."),
+    calib: Path | None = typer.Option(None, help="KITTI calib.txt (with --poses)."),
+    label_names: str | None = typer.Option(
+        None, help="Names of a cloud's integer labels, e.g. '0=grass,1=car'."
+    ),
+    encoder_name: str = typer.Option(
+        "minilm", "--encoder", help="Registered encoder name or package.module:factory."
+    ),
+    noise: float = typer.Option(0.0, help="Caption noise per view (labelled input)."),
+    seed: int = typer.Option(0, help="Seed of the caption noise."),
+    radius: float = typer.Option(0.15, help="Association radius of scan points to map points [m]."),
+    terrain_threshold: float | None = typer.Option(None, help="Override the terrain threshold."),
+    object_threshold: float | None = typer.Option(None, help="Override α, the object threshold."),
+    cell_size: float | None = typer.Option(None, help="Terrain grid cell size [m]."),
+    param: list[str] = typer.Option([], help="Any graph parameter as NAME=VALUE (repeatable)."),
+    evaluate: bool = typer.Option(
+        False, help="Score objects against the scans' instance labels (SemanticKITTI)."
+    ),
+) -> None:
+    import dataclasses
+    import json
+
+    from rich.progress import Progress
+
+    from seminspect.core.errors import InvalidInputError
+    from seminspect.core.io import atomic_write_text
+    from seminspect.graphs.terrain.params import make_terrain_params
+    from seminspect.graphs.terrain.prompting import TaskPrompts
+    from seminspect.graphs.terrain.scene_graph import build_terrain_graph
+    from seminspect.perception.encoders import CaptionEncoder, calibration_for, make_encoder
+
+    prompts = TaskPrompts.parse(terrain, objects)
+    params = make_terrain_params(_param_overrides(param, cell_size))
+    encoder = make_encoder(encoder_name)
+    if noise and isinstance(encoder, CaptionEncoder):
+        encoder = dataclasses.replace(encoder, noise=noise, seed=seed)
+    calibration = calibration_for(encoder.name)
+    if terrain_threshold is not None or object_threshold is not None:
+        calibration = dataclasses.replace(
+            calibration,
+            terrain=calibration.terrain if terrain_threshold is None else terrain_threshold,
+            objects=calibration.objects if object_threshold is None else object_threshold,
+        )
+    options = {"poses": poses, "calib": calib, "radius": radius, "label_names": label_names}
+    with Progress(console=console, transient=True) as progress:
+        cloud, fused = _load_cloud(inputs, labels, options, encoder, progress)
+        stages = progress.add_task("phase 2", total=5)
+
+        def on_stage(name: str) -> None:
+            progress.update(stages, description=f"phase 2: {name}", advance=1)
+
+        build = build_terrain_graph(
+            cloud, prompts, encoder, params=params, calibration=calibration, on_stage=on_stage
+        )
+        if evaluate and fused is None:
+            raise InvalidInputError("--evaluate needs SemanticKITTI scans with instance labels")
+        quality = _quality(build, fused, encoder) if evaluate else None
+        _write_outputs(out, build, cloud, progress)
+    summary = {
+        "cloud_points": len(cloud),
+        **build.scene.summary(),
+        "seconds": build.timings,
+        "quality": quality,
+    }
+    atomic_write_text(out / "summary.json", json.dumps(summary, indent=2) + "\n")
+    console.print(f"[bold]terrain graph[/] written to {out}")
+    console.print_json(json.dumps({k: v for k, v in summary.items() if k != "seconds"}))
+
+
+@app.command("route")
+def route(
+    graph_file: Path = typer.Argument(..., help="graph.json written by 'terrain graph'."),
+    start: str = typer.Option(..., "--from", help="Start place id, e.g. place-3."),
+    goal: str = typer.Option(..., "--to", help="Goal place id."),
+    terrain: str | None = typer.Option(None, help="Terrain types allowed, comma-separated."),
+) -> None:
+    """Shortest route between two places over the chosen terrain types."""
+    from seminspect.graphs.terrain.navigation import shortest_route
+    from seminspect.graphs.terrain.serialization import load_terrain_graph
+
+    scene = load_terrain_graph(graph_file)
+    allowed = [t.strip() for t in terrain.split(",") if t.strip()] if terrain else None
+    places, length = shortest_route(scene, start, goal, allowed)
+    console.print(f"{len(places)} places, {length:.1f} m: " + " -> ".join(places))

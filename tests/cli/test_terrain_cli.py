@@ -1,0 +1,50 @@
+import json
+
+import numpy as np
+from typer.testing import CliRunner
+
+from seminspect.cli import app, main
+
+runner = CliRunner()
+
+
+def test_graph_command_end_to_end_on_a_small_cloud(tmp_path, labelled_scene, fake_encoder) -> None:
+    points, labels, names = labelled_scene
+    cloud = tmp_path / "scene.npz"
+    np.savez(cloud, points=points, labels=labels)
+    out = tmp_path / "out"
+    spec = ",".join(f"{k}={v}" for k, v in names.items())
+    result = runner.invoke(
+        app,
+        ["terrain", "graph", str(cloud), "--out", str(out), "--encoder", "hashing-test",
+         "--label-names", spec, "--param", "split_length=6.0"],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["objects"] == {"image of a tree": 2, "image of a car": 3}
+    assert all(n > 0 for n in summary["places"].values())
+    for name in ("graph.json", "graph.graphml", "layer1.npz", "classified_cloud.png",
+                 "places.png", "layers.png", "gvd_0_sidewalk.png"):  # fmt: skip
+        assert (out / name).stat().st_size > 0, name
+    graph = json.loads((out / "graph.json").read_text())
+    places = [n["id"] for n in graph["nodes"] if n["kind"] == "place"]
+    route = runner.invoke(
+        app, ["terrain", "route", str(out / "graph.json"), "--from", places[0], "--to", places[0]]
+    )
+    assert route.exit_code == 0 and "1 places" in route.output
+
+
+def test_errors_are_one_line_and_exit_non_zero(tmp_path, capsys) -> None:
+    broken = tmp_path / "broken.pcd"
+    broken.write_bytes(b"VERSION 0.7\nFIELDS x y z\n")
+    for argv in (
+        ["terrain", "graph", str(broken), "--out", str(tmp_path / "o")],
+        ["terrain", "graph", str(broken), "--out", str(tmp_path / "o"), "--encoder", "nope"],
+        ["terrain", "graph", str(broken), "--out", str(tmp_path / "o"), "--param", "cell_size=0"],
+    ):
+        try:
+            main(argv)
+        except SystemExit as exc:
+            assert exc.code == 1
+        error = capsys.readouterr().err.strip()
+        assert error.startswith("error:") and "\n" not in error, error
