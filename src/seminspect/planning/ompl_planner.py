@@ -47,6 +47,10 @@ class OmplPlanner:
         band: ``(z_low, z_high)`` plans in x-y for a ground robot on that height band.
         seed: seed of OMPL's random generator for each query.
         time_limit: seconds RRT-Connect may search before the query fails.
+
+    Attributes:
+        grid: the prepared :class:`CostGrid` (its blocked cells are what is checked).
+        build_time: seconds spent preparing the map.
     """
 
     def __init__(
@@ -61,7 +65,9 @@ class OmplPlanner:
         if not time_limit > 0:
             raise InvalidInputError(f"time_limit must be > 0 s, got {time_limit!r}")
         self._ompl_seed = int(make_rng(seed, "planning", "ompl").integers(1, 2**31))
+        t0 = time.perf_counter()
         self.grid = CostGrid.build(voxel_map, model, band)
+        self.build_time = time.perf_counter() - t0
         self.time_limit = time_limit
         self._dims = 2 if self.grid.planar else 3
 
