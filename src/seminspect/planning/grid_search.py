@@ -289,8 +289,8 @@ def make_query(
             f"goal {format_point(goal_pt)} is {_blocked_reason(grid)}; "
             "give a goal radius to stop next to it"
         )
-    offsets = candidates - goal_cell
-    octile = [_octile(int(a), int(b), int(c)) for a, b, c in offsets]
+    big, mid, small = np.sort(np.abs(candidates - goal_cell), axis=1)[:, ::-1].T
+    octile = (big - mid) + _SQRT2 * (mid - small) + _SQRT3 * small
     return Query(
         start_pt,
         goal_pt,
@@ -298,7 +298,7 @@ def make_query(
         goal_cell,
         float(goal_radius),
         goal_cells,
-        max(octile) * grid.resolution,
+        float(octile.max()) * grid.resolution,
     )
 
 
@@ -311,7 +311,7 @@ def _escape(grid: CostGrid, start: NDArray[np.float64], tolerance: float) -> NDA
     return free[int(np.argmin(np.einsum("ij,ij->i", delta, delta)))]
 
 
-def route_waypoints(grid: CostGrid, query: Query, cells: NDArray[np.int64]) -> NDArray[np.float64]:
+def _route_waypoints(grid: CostGrid, query: Query, cells: NDArray[np.int64]) -> NDArray[np.float64]:
     """World waypoints of a cell route: the exact start, the cell centres, the exact goal when
     the goal is a single cell. Planar grids keep the start's height throughout."""
     z = float(query.start[2])
@@ -339,7 +339,7 @@ def make_path(
     started: float,
 ) -> GridPath:
     """Package a cell route found by any engine; ``started`` is the query's ``perf_counter``."""
-    waypoints = route_waypoints(grid, query, cells)
+    waypoints = _route_waypoints(grid, query, cells)
     return GridPath(
         waypoints=waypoints,
         length=path_length(waypoints),
