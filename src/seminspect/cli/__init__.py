@@ -20,7 +20,9 @@ from seminspect.core.errors import SeminspectError
 
 #: (module under seminspect.cli, group name, one-line help)
 #: Group modules import heavy dependencies inside their commands so ``--help`` stays fast.
-GROUPS: tuple[tuple[str, str, str], ...] = ()
+GROUPS: tuple[tuple[str, str, str], ...] = (
+    ("world", "world", "List, draw and export the built-in simulated worlds."),
+)
 
 app = typer.Typer(
     name="seminspect",
