@@ -78,7 +78,7 @@ def show(
             str(len(info.parts)),
         )
     console.print(table)
-    console.print(f"wrote {target}")
+    console.print(f"wrote {target}", soft_wrap=True)
 
 
 @app.command()
@@ -96,5 +96,6 @@ def export(
     summary = world.summary()
     console.print(
         f"wrote {out / 'world.ply'} and {out / 'labels.json'}: {summary['faces']} faces, "
-        f"objects {summary['objects']}"
+        f"objects {summary['objects']}",
+        soft_wrap=True,
     )
