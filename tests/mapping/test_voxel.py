@@ -174,3 +174,17 @@ def test_inflation_grows_occupied_cells_by_a_radius() -> None:
     assert grid.inflated(0.05).counts() == grid.counts()
     with pytest.raises(InvalidInputError):
         grid.inflated(-1.0)
+
+
+@pytest.mark.parametrize(
+    ("start", "end"),
+    [
+        ((0.0, 1.0, 0.0), (0.0, 0.0, 1.0)),
+        ((1.0, 1.0, 1.0), (2.0, 2.0, 2.0)),
+        ((3, 0, 0), (0, 3, 0)),
+    ],
+)
+def test_rays_along_cell_edges_still_occupy_their_end(start, end) -> None:
+    grid = VoxelMap.empty([0, 0, 0], [5, 5, 5], 1.0)
+    grid.integrate_rays(start, [end], [True])
+    assert grid.state_at(end) == OCCUPIED

@@ -72,8 +72,7 @@ def _walk(states: np.ndarray, o: np.ndarray, d: np.ndarray, hit: bool) -> None:
         occupy_end = occupy_end and 0.0 <= o[k] + d[k] < shape[k]
     for _ in range(shape[0] + shape[1] + shape[2] + 3):
         if cell[0] == last[0] and cell[1] == last[1] and cell[2] == last[2]:
-            _mark(states, cell[0], cell[1], cell[2], OCCUPIED if occupy_end else FREE)
-            return
+            break
         _mark(states, cell[0], cell[1], cell[2], FREE)
         axis = 0
         if t_max[1] < t_max[axis]:
@@ -81,11 +80,13 @@ def _walk(states: np.ndarray, o: np.ndarray, d: np.ndarray, hit: bool) -> None:
         if t_max[2] < t_max[axis]:
             axis = 2
         if t_max[axis] > t1:
-            return
+            break
         cell[axis] += step[axis]
         if cell[axis] < 0 or cell[axis] >= shape[axis]:
-            return
+            break
         t_max[axis] += t_delta[axis]
+    # The end cell is set even when rounding let the walk slip past it along an edge or corner.
+    _mark(states, last[0], last[1], last[2], OCCUPIED if occupy_end else FREE)
 
 
 @numba.njit(cache=True)
