@@ -18,7 +18,6 @@ from seminspect.worlds.shapes import Piece, box, cylinder, pose_matrix, sphere
 from seminspect.worlds.world import World
 
 SCENARIOS = {str(n): n for n in (0, 4, 9, 14, 19)}
-WALL = 0.2
 
 
 def _primitive(rng: np.random.Generator) -> Piece:
@@ -29,6 +28,15 @@ def _primitive(rng: np.random.Generator) -> Piece:
     if kind == 1:
         return cylinder(size[0] / 2, size[2], "")
     return sphere(size[0] / 2, "")
+
+
+def _add_shell(builder: WorldBuilder, length: float, width: float, height: float) -> None:
+    """Four walls and a ceiling as single surfaces facing into the room (class ``wall``)."""
+    footprint = [(0.0, 0.0), (length, 0.0), (length, width), (0.0, width)]
+    corners = np.array([(x, y, z) for z in (0.0, height) for x, y in footprint])
+    quads = [(0, 4, 5, 1), (1, 5, 6, 2), (2, 6, 7, 3), (3, 7, 4, 0), (4, 7, 6, 5)]
+    faces = [tri for a, b, c, d in quads for tri in ((a, b, c), (a, c, d))]
+    builder.add_faces(corners, faces, "wall")
 
 
 def _spot(rng: np.random.Generator, length: float, width: float, keep_away: np.ndarray):
@@ -49,15 +57,7 @@ def generate_room(scenario: str, seed: int) -> World:
     height = rng.uniform(2.0, 8.0)
     builder = WorldBuilder("room", seed)
     builder.add_ground((0.0, 0.0), (length, width))
-    walls = [
-        box((-WALL, -WALL, 0.0), (length + WALL, 0.0, height), ""),
-        box((-WALL, width, 0.0), (length + WALL, width + WALL, height), ""),
-        box((-WALL, 0.0, 0.0), (0.0, width, height), ""),
-        box((length, 0.0, 0.0), (length + WALL, width, height), ""),
-        box((-WALL, -WALL, height), (length + WALL, width + WALL, height + WALL), ""),
-    ]
-    for wall in walls:
-        builder.add_piece(wall, "wall")
+    _add_shell(builder, length, width, height)
     target = cylinder(0.4, 1.0, "", sections=15)
     tx, ty = rng.uniform(1.0, length - 1.0), rng.uniform(1.0, width - 1.0)
     builder.add_object([target], "target", pose_matrix((tx, ty, 0.5)))
