@@ -20,6 +20,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 from numpy.typing import NDArray
 
@@ -107,6 +108,7 @@ def draw_3d(world: World, ax: Axes, elevation: float = 35.0, azimuth: float = -6
     ax.set_ylim(lo[1], hi[1])
     ax.set_zlim(lo[2], hi[2])
     ax.set_box_aspect(tuple(hi - lo))
+    ax.zaxis.set_major_locator(MaxNLocator(nbins=3))  # flat worlds leave little room for ticks
     ax.view_init(elev=elevation, azim=azimuth)
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
