@@ -92,6 +92,19 @@ def test_saved_worlds_reload_exactly(tmp_path: Path) -> None:
     assert again.metadata["scenario"] == "small"
 
 
+def test_saved_worlds_keep_their_ground_height(tmp_path: Path) -> None:
+    # rubble sinks below the ground, so the mesh's lowest point is not the ground
+    world = generate_world("collapsed-buildings", "fire-station")
+    assert world.mesh.vertices[:, 2].min() < -0.05
+    save_world(world, tmp_path)
+    again = load_world(tmp_path / "world.ply", tmp_path / "labels.json")
+    assert again.ground_z == world.ground_z == 0.0
+    points = np.random.default_rng(0).uniform([0, 0, 0.7], [80, 56, 0.7], (2000, 3))
+    np.testing.assert_array_equal(
+        world.clearance(points, "ground"), again.clearance(points, "ground")
+    )
+
+
 def test_glb_node_names_select_faces(tmp_path: Path) -> None:
     scene = trimesh.Scene()
     scene.add_geometry(trimesh.creation.box((1, 1, 1)), node_name="chassis", geom_name="m0")

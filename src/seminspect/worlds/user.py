@@ -305,7 +305,8 @@ def load_world(mesh_path: str | os.PathLike[str], labels_path: str | os.PathLike
             lo, hi = lo - margin, hi + margin
         bounds = np.array(labels.bounds or [lo, hi + np.array([0.0, 0.0, 2.0])])
         start = labels.start or _Start(position=(bounds[0, 0] + 1.0, bounds[0, 1] + 1.0, lo[2]))
-        metadata = {**labels.metadata, "ground_z": float(lo[2]), "source": str(mesh_path)}
+        # the ground is the mesh's lowest point unless the file says otherwise (a saved world)
+        metadata = {"ground_z": float(lo[2]), **labels.metadata, "source": str(mesh_path)}
         return builder.build(bounds, start.position, start.yaw, metadata)
     except InvalidInputError as exc:
         raise FileFormatError(f"{source}: {exc}") from None
@@ -369,7 +370,7 @@ def save_world(world: World, directory: str | os.PathLike[str]) -> Path:
     if target.exists() and not target.is_dir():
         raise InvalidInputError(f"{target} exists and is not a directory")
     atomic_write_bytes(target / "world.ply", _ply_bytes(world.mesh.vertices, world.mesh.faces))
-    metadata = {k: v for k, v in world.metadata.items() if k not in ("ground_z", "source")}
+    metadata = {k: v for k, v in world.metadata.items() if k != "source"}
     payload = {
         "name": world.name,
         "seed": world.seed,
