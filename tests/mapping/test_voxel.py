@@ -1,8 +1,15 @@
+import math
+
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from seminspect.core.errors import InvalidInputError
+from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap
+from seminspect.sensors import CameraModel, Lidar, render
+from sim_worlds import box_world
 
 
 def test_index_round_trip_and_bounds() -> None:
@@ -40,3 +47,144 @@ def test_impossible_maps_are_refused(lower, upper, res) -> None:
 def test_huge_map_is_refused_before_allocating() -> None:
     with pytest.raises(InvalidInputError, match="coarser"):
         VoxelMap.empty([0, 0, 0], [10_000, 10_000, 100], 0.01)
+
+
+# ----------------------------------------------------------------- ray integration
+def test_a_hit_clears_its_ray_and_occupies_its_end() -> None:
+    grid = VoxelMap.empty([0, 0, 0], [10, 1, 1], 1.0)
+    grid.integrate_rays([0.5, 0.5, 0.5], [[7.5, 0.5, 0.5]], [True])
+    assert grid.states[:, 0, 0].tolist() == [FREE] * 7 + [OCCUPIED, UNKNOWN, UNKNOWN]
+    grid.integrate_rays([0.5, 0.5, 0.5], [[9.5, 0.5, 0.5]], [False])  # a miss clears to its end
+    assert grid.states[:, 0, 0].tolist() == [FREE] * 7 + [OCCUPIED, FREE, FREE]  # sticky
+
+
+def test_rays_are_clipped_to_the_map() -> None:
+    grid = VoxelMap.empty([0, 0, 0], [4, 4, 1], 1.0)
+    grid.integrate_rays([[-5.0, 0.5, 0.5]], [[2.5, 0.5, 0.5]], [True])  # enters from outside
+    assert grid.states[:, 0, 0].tolist() == [FREE, FREE, OCCUPIED, UNKNOWN]
+    grid.integrate_rays([[0.5, 1.5, 0.5]], [[9.0, 1.5, 0.5]], [True])  # hit beyond the map
+    assert grid.states[:, 1, 0].tolist() == [FREE] * 4
+    grid.integrate_rays([[-5.0, -5.0, 0.5]], [[-1.0, 9.0, 0.5]], [True])  # never inside
+    assert grid.counts()["free"] == 6
+    grid.integrate_rays([0, 0, 0], np.zeros((0, 3)), [])  # nothing to do
+
+
+@pytest.mark.parametrize(
+    ("origins", "ends", "hit"),
+    [
+        ([0, 0, 0], [[1, 1, 1]], [True, False]),
+        (np.zeros((2, 3)), [[1, 1, 1]], [True]),
+        ([0, 0, math.nan], [[1, 1, 1]], [True]),
+        ([0, 0, 0], [[1, 1]], [True]),
+    ],
+)
+def test_bad_rays_are_refused(origins, ends, hit) -> None:
+    with pytest.raises(InvalidInputError):
+        VoxelMap.empty([0, 0, 0], [2, 2, 2], 1.0).integrate_rays(origins, ends, hit)
+
+
+coordinate = st.floats(-1.0, 6.0, allow_nan=False)
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.tuples(coordinate, coordinate, coordinate), st.tuples(coordinate, coordinate, coordinate))
+def test_traversal_marks_only_cells_on_the_segment(start, end) -> None:
+    grid = VoxelMap.empty([0, 0, 0], [5, 5, 5], 1.0)
+    a, b = np.array(start), np.array(end)
+    grid.integrate_rays(a, [b], [True])
+    marked = np.argwhere(grid.states != UNKNOWN) + 0.5
+    if len(marked):
+        # every marked cell centre lies within half a cell diagonal of the segment
+        direction = b - a
+        t = np.clip(((marked - a) @ direction) / max(direction @ direction, 1e-12), 0.0, 1.0)
+        gap = np.linalg.norm(a + t[:, None] * direction - marked, axis=1)
+        assert gap.max() <= math.sqrt(3) / 2 + 1e-6
+    reached = a + (b - a)  # the end as the kernel computes it (to the last bit)
+    if np.all((reached >= 0) & (reached < 5)):
+        assert grid.state_at(reached) == OCCUPIED
+    if np.all((a >= 0) & (a < 5)) and not np.array_equal(np.floor(a), np.floor(reached)):
+        assert grid.state_at(a) == FREE
+
+
+# ----------------------------------------------------------------- maps from worlds and sensors
+@pytest.fixture(scope="module")
+def wall_world():
+    return box_world(lower=(5.0, -3.0, 0.0), upper=(6.0, 3.0, 3.0), size=(20.0, 12.0, 4.0))
+
+
+def test_map_from_the_world(wall_world) -> None:
+    truth = VoxelMap.from_world(wall_world, 0.25)
+    assert truth.origin[2] == pytest.approx(-0.125)  # the ground runs through the bottom layer
+    assert (truth.states[:, :, 0] == OCCUPIED).all() and (truth.states[:, :, 1:] != UNKNOWN).all()
+    assert truth.state_at([[5.6, 0.1, 1.5], [5.0, 0.0, 1.0], [3.0, 0.0, 1.0]]).tolist() == [
+        FREE,  # inside the solid box: only cells touching its surface are occupied
+        OCCUPIED,
+        FREE,
+    ]
+    boxed = VoxelMap.from_world(wall_world, 0.5, bounds=[(0, -2, 0.5), (4, 2, 2)])
+    assert boxed.counts()["occupied"] == 0
+
+
+def test_depth_frames_agree_with_the_world(wall_world) -> None:
+    truth = VoxelMap.from_world(wall_world, 0.2)
+    grid = VoxelMap.covering(wall_world, 0.2)
+    for yaw in (-0.4, 0.0, 0.4):
+        frame = render(wall_world, CameraModel(), (0.0, 0.0, 1.0), quat_from_yaw(yaw))
+        grid.integrate_frame(frame, stride=4)
+    occupied = grid.states == OCCUPIED
+    free = grid.states == FREE
+    assert occupied.sum() > 500 and free.sum() > 20_000
+    assert (truth.states[occupied] == OCCUPIED).mean() > 0.99
+    assert (truth.states[free] == FREE).mean() > 0.97
+    assert grid.state_at([7.0, 0.0, 1.0]) == UNKNOWN  # behind the wall
+    assert grid.state_at([2.0, 0.0, 1.0]) == FREE
+
+
+def test_odometry_frames_and_lidar_scans(wall_world) -> None:
+    frame = render(
+        wall_world,
+        CameraModel(160, 120),
+        (0.0, 0.0, 1.0),
+        quat_from_yaw(0.0),
+        odometry=((0.0, 1.0, 1.0), quat_from_yaw(0.0)),
+    )
+    true_map, believed = VoxelMap.covering(wall_world, 0.2), VoxelMap.covering(wall_world, 0.2)
+    true_map.integrate_frame(frame, stride=1)
+    believed.integrate_frame(frame, stride=1, use_odometry=True)
+    assert believed.state_at([5.1, 3.6, 1.0]) == OCCUPIED  # the wall edge, shifted by 1 m
+    assert true_map.state_at([5.1, 3.6, 1.0]) != OCCUPIED
+    scan = Lidar(horizontal_resolution_deg=1.0).scan(wall_world, (0.0, 0.0, 1.0), quat_from_yaw(0))
+    lidar_map = VoxelMap.covering(wall_world, 0.2)
+    lidar_map.integrate_scan(scan)
+    assert lidar_map.state_at([5.05, 0.0, 1.0]) == OCCUPIED
+    assert lidar_map.counts()["occupied"] > 300
+    with pytest.raises(InvalidInputError, match="stride"):
+        true_map.integrate_frame(frame, stride=0)
+
+
+def test_inflation_grows_occupied_cells_by_a_radius() -> None:
+    grid = VoxelMap.empty([0, 0, 0], [3, 3, 3], 0.1)
+    grid.states[15, 15, 15] = OCCUPIED
+    grid.states[0, 0, 0] = FREE
+    inflated = grid.inflated(0.2)
+    grown = np.argwhere(inflated.states == OCCUPIED)
+    assert len(grown) == 33  # the cells within two cell lengths of the centre
+    assert np.abs(grown - 15).max() == 2
+    assert inflated.states[0, 0, 0] == FREE and grid.counts()["occupied"] == 1
+    assert grid.inflated(0.05).counts() == grid.counts()
+    with pytest.raises(InvalidInputError):
+        grid.inflated(-1.0)
+
+
+@pytest.mark.parametrize(
+    ("start", "end"),
+    [
+        ((0.0, 1.0, 0.0), (0.0, 0.0, 1.0)),
+        ((1.0, 1.0, 1.0), (2.0, 2.0, 2.0)),
+        ((3, 0, 0), (0, 3, 0)),
+    ],
+)
+def test_rays_along_cell_edges_still_occupy_their_end(start, end) -> None:
+    grid = VoxelMap.empty([0, 0, 0], [5, 5, 5], 1.0)
+    grid.integrate_rays(start, [end], [True])
+    assert grid.state_at(end) == OCCUPIED

@@ -25,6 +25,7 @@ from seminspect.core.errors import SeminspectError
 GROUPS: tuple[tuple[str, str, str], ...] = (
     ("graph", "graph", "Inspect, query and export 3D Layered Semantic Graphs."),
     ("terrain", "terrain", "Terrain-aware, task-driven outdoor scene graphs (paper 001)."),
+    ("world", "world", "List, draw and export the built-in simulated worlds."),
 )
 
 app = typer.Typer(

@@ -1,1 +1,22 @@
 """Simulated sensors: ray-cast depth + segmentation camera, intensity image, LiDAR, noise models."""
+
+from seminspect.sensors.camera import CameraModel, Frame, render
+from seminspect.sensors.detection import Detection, detect, detect_instances, detect_parts
+from seminspect.sensors.lidar import Lidar, LidarScan
+from seminspect.sensors.noise import NoiseModel, make_noise, noise_preset, require_rng
+
+__all__ = [
+    "CameraModel",
+    "Detection",
+    "Frame",
+    "Lidar",
+    "LidarScan",
+    "NoiseModel",
+    "detect",
+    "detect_instances",
+    "detect_parts",
+    "make_noise",
+    "noise_preset",
+    "render",
+    "require_rng",
+]

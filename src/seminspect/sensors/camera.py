@@ -1,0 +1,253 @@
+"""The depth + segmentation + intensity camera, rendered by ray casting.
+
+Frames: the camera looks along its body +X axis with +Y to the left and +Z up; pixel ``(u, v)``
+runs right and down. In the usual optical frame (x right, y down, z forward) the intrinsics
+``K`` map a point to pixel coordinates, with square pixels and the principal point at the image
+centre. ``Frame.depth`` is the distance along the optical axis (a depth camera's z), not along
+the ray.
+
+The defaults are the simulated camera of 000 Table 1: 640 x 480 pixels, a 69.4 deg horizontal
+field of view and d_max = 30 m (the experimental camera has 86 deg).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.spatial.transform import Rotation
+
+from seminspect.core.errors import InvalidInputError
+from seminspect.core.params import InspectionParams
+from seminspect.geometry.transforms import Quat, Vec3, as_point, as_quaternion
+from seminspect.sensors.noise import NoiseModel, require_rng
+from seminspect.sensors.shading import OCTAVE_WEIGHTS, OCTAVES, shade_hits, surface_tables
+from seminspect.worlds import World
+
+
+@dataclass(frozen=True)
+class CameraModel:
+    """A pinhole camera: image size, horizontal field of view and maximum range."""
+
+    width: int = 640
+    height: int = 480
+    hfov_deg: float = 69.4
+    max_range: float = 30.0
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.width, int) and isinstance(self.height, int)):
+            raise InvalidInputError("camera width and height must be integers")
+        if not (1 <= self.width <= 8192 and 1 <= self.height <= 8192):
+            raise InvalidInputError(f"camera size {self.width}x{self.height} is out of range")
+        if not (math.isfinite(self.hfov_deg) and 1.0 <= self.hfov_deg <= 170.0):
+            raise InvalidInputError(f"horizontal FOV must be 1-170 deg, got {self.hfov_deg}")
+        if not (math.isfinite(self.max_range) and self.max_range > 0):
+            raise InvalidInputError(f"camera max range must be > 0, got {self.max_range}")
+
+    @classmethod
+    def from_params(cls, params: InspectionParams) -> CameraModel:
+        """The camera described by 000 Table 1/2 symbols: alpha, I_w, I_h and d_max."""
+        return cls(params.image_width, params.image_height, params.fov_deg, params.d_max)
+
+    @property
+    def fx(self) -> float:
+        """Focal length in pixels."""
+        return (self.width / 2) / math.tan(math.radians(self.hfov_deg) / 2)
+
+    @property
+    def cx(self) -> float:
+        return (self.width - 1) / 2
+
+    @property
+    def cy(self) -> float:
+        return (self.height - 1) / 2
+
+    @property
+    def K(self) -> NDArray[np.float64]:  # noqa: N802 - the usual symbol for intrinsics
+        """3x3 intrinsics (optical frame, square pixels)."""
+        return np.array([[self.fx, 0.0, self.cx], [0.0, self.fx, self.cy], [0.0, 0.0, 1.0]])
+
+    @property
+    def vfov_deg(self) -> float:
+        """Vertical field of view that follows from the size and the horizontal one."""
+        return math.degrees(2 * math.atan((self.height / 2) / self.fx))
+
+    def scaled(self, stride: int) -> CameraModel:
+        """The same field of view with every ``stride``-th pixel: a cheap render for mapping."""
+        if not (isinstance(stride, int) and stride >= 1):
+            raise InvalidInputError(f"stride must be a positive integer, got {stride!r}")
+        if stride == 1:
+            return self
+        return replace(
+            self, width=max(1, self.width // stride), height=max(1, self.height // stride)
+        )
+
+    @cached_property
+    def rays(self) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+        """Unit ray directions in the body frame, ``(H*W, 3)`` row-major, and their x parts."""
+        u, v = np.meshgrid(np.arange(self.width), np.arange(self.height))
+        body = np.stack(
+            [np.full(u.shape, self.fx), -(u - self.cx), -(v - self.cy)], axis=-1
+        ).reshape(-1, 3)
+        body /= np.linalg.norm(body, axis=1, keepdims=True)
+        return body.astype(np.float32), np.ascontiguousarray(body[:, 0], dtype=np.float32)
+
+
+@dataclass(eq=False)
+class Frame:
+    """One rendered image: depth, labels and intensity, with the pose it was taken from.
+
+    Attributes:
+        depth: ``float32`` (H, W) metres along the optical axis; ``inf`` where nothing lies
+            within the camera's range.
+        instance: ``int32`` instance id per pixel (0: ground, background or nothing).
+        class_id: ``int16`` index into ``World.class_names`` (0 where nothing was hit).
+        part_id: ``int16`` index into ``World.part_names`` (0: no part).
+        intensity: ``uint8`` grey image with a stable surface texture.
+        face: ``int32`` index of the mesh face seen by each pixel (-1: none).
+        position, orientation: the true camera pose the frame was rendered from.
+        stamp: time the frame is tagged with (seconds).
+        camera: the camera model (its scaled version for strided renders).
+        odometry_position, odometry_orientation: the pose the robot believed it had at
+            ``stamp``; equal to the true pose unless the caller passes odometry.
+    """
+
+    depth: NDArray[np.float32]
+    instance: NDArray[np.int32]
+    class_id: NDArray[np.int16]
+    part_id: NDArray[np.int16]
+    intensity: NDArray[np.uint8]
+    face: NDArray[np.int32]
+    position: Vec3
+    orientation: Quat
+    stamp: float
+    camera: CameraModel
+    odometry_position: Vec3 = field(default=None)  # type: ignore[assignment]
+    odometry_orientation: Quat = field(default=None)  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        if self.odometry_position is None:
+            self.odometry_position = self.position
+        if self.odometry_orientation is None:
+            self.odometry_orientation = self.orientation
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.depth.shape  # type: ignore[return-value]
+
+    def points(self, mask: ArrayLike | None = None, use_odometry: bool = False) -> NDArray:
+        """World points ``(N, 3)`` of the pixels in ``mask`` that saw a surface (row-major).
+
+        With ``use_odometry`` the points are placed from the odometry pose, as a robot whose
+        estimate is off (drift, image/odometry desync) would place them.
+        """
+        valid = np.isfinite(self.depth)
+        if mask is not None:
+            chosen = np.asarray(mask, dtype=bool)
+            if chosen.shape != self.shape:
+                raise InvalidInputError(f"mask shape {chosen.shape} != frame shape {self.shape}")
+            valid &= chosen
+        directions, cosine = self.camera.rays
+        flat = np.flatnonzero(valid)
+        scale = (self.depth.ravel()[flat] / cosine[flat])[:, None]
+        body = directions[flat] * scale
+        position, orientation = (
+            (self.odometry_position, self.odometry_orientation)
+            if use_odometry
+            else (self.position, self.orientation)
+        )
+        return body @ Rotation.from_quat(orientation).as_matrix().T + position
+
+
+def render(
+    world: World,
+    camera: CameraModel,
+    position: ArrayLike,
+    orientation: ArrayLike,
+    *,
+    noise: NoiseModel | None = None,
+    rng: np.random.Generator | None = None,
+    stamp: float = 0.0,
+    stride: int = 1,
+    odometry: tuple[ArrayLike, ArrayLike] | None = None,
+) -> Frame:
+    """Render a frame of ``world`` from the camera pose ``(position, orientation [x,y,z,w])``.
+
+    Args:
+        noise: depth and intensity noise (``None``: ideal).
+        rng: generator for the noise; required when the noise model is not ideal.
+        stamp: time the frame is tagged with.
+        stride: render every ``stride``-th pixel (see :meth:`CameraModel.scaled`).
+        odometry: the ``(position, orientation)`` the robot believed it had at ``stamp``.
+    """
+    origin = as_point(position, "camera position")
+    quat = as_quaternion(orientation, "camera orientation")
+    model = camera.scaled(stride)
+    directions_body, cosine = model.rays
+    rotation = Rotation.from_quat(quat).as_matrix().astype(np.float32)
+    directions = directions_body @ rotation.T
+    distance, face = world.raycaster.cast(origin, directions, model.max_range / cosine)
+    count = len(face)
+    depth = np.empty(count, dtype=np.float32)
+    instance = np.empty(count, dtype=np.int32)
+    class_id = np.empty(count, dtype=np.int16)
+    part_id = np.empty(count, dtype=np.int16)
+    intensity = np.empty(count, dtype=np.uint8)
+    albedo, axes, seed, sun = surface_tables(world)
+    shade_hits(
+        distance,
+        face,
+        directions,
+        cosine,
+        origin,
+        1.0 / model.fx,
+        world.face_instance,
+        world.face_class,
+        world.face_part,
+        albedo,
+        axes,
+        seed,
+        sun,
+        OCTAVES,
+        OCTAVE_WEIGHTS,
+        depth,
+        instance,
+        class_id,
+        part_id,
+        intensity,
+    )
+    shape = (model.height, model.width)
+    frame = Frame(
+        depth=depth.reshape(shape),
+        instance=instance.reshape(shape),
+        class_id=class_id.reshape(shape),
+        part_id=part_id.reshape(shape),
+        intensity=intensity.reshape(shape),
+        face=face.reshape(shape),
+        position=origin,
+        orientation=quat,
+        stamp=float(stamp),
+        camera=model,
+        odometry_position=None if odometry is None else as_point(odometry[0], "odometry position"),
+        odometry_orientation=None
+        if odometry is None
+        else as_quaternion(odometry[1], "odometry orientation"),
+    )
+    if noise is not None and not noise.is_ideal:
+        _add_image_noise(frame, noise, require_rng(rng))
+    return frame
+
+
+def _add_image_noise(frame: Frame, noise: NoiseModel, rng: np.random.Generator) -> None:
+    """Depth noise with a range-dependent sigma, and pixel noise on the intensity image."""
+    hit = np.isfinite(frame.depth)
+    if noise.depth_noise_m or noise.depth_noise_per_m:
+        sigma = noise.depth_noise_m + noise.depth_noise_per_m * frame.depth[hit]
+        noisy = frame.depth[hit] + rng.standard_normal(sigma.shape).astype(np.float32) * sigma
+        frame.depth[hit] = np.maximum(noisy, np.float32(1e-3))
+    if noise.intensity_noise:
+        jitter = rng.normal(0.0, noise.intensity_noise, frame.intensity.shape)
+        frame.intensity[:] = np.clip(frame.intensity + jitter, 0, 255).astype(np.uint8)

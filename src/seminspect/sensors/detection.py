@@ -1,0 +1,212 @@
+"""Simulated instance and part segmentation, derived from a frame's ground-truth labels.
+
+A detection is what a segmentation model (YOLOv8-seg in 000 Sec VI-B) reports: a label, a mask,
+the mask's area in pixels and a confidence score. The ground-truth instance id is attached for
+evaluation only (-1 for false positives). The faults of :class:`NoiseModel` are applied in this
+order: erosion, bleeding into the background (pixels of instance 0), the minimum area, missed
+detections, confidence noise, and finally false positives (random ellipses).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from typing import Literal
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+from seminspect.core.errors import InvalidInputError
+from seminspect.sensors.camera import Frame
+from seminspect.sensors.noise import NoiseModel, require_rng
+from seminspect.worlds import World
+
+Level = Literal["instance", "part"]
+
+
+@dataclass(eq=False)
+class Detection:
+    """One segmented object or part.
+
+    Attributes:
+        label: class name (``car``) for objects, part name (``hood``) for parts.
+        mask: ``bool`` (H, W) pixels of the detection.
+        area_px: number of mask pixels.
+        score: confidence in (0, 1].
+        bbox: ``(x0, y0, x1, y1)`` pixel box, upper bounds exclusive.
+        instance_id: ground-truth object id, for evaluation only; -1 for a false positive.
+        level: ``"instance"`` or ``"part"``.
+        depth_m: median finite depth under the mask (``inf`` if none).
+    """
+
+    label: str
+    mask: NDArray[np.bool_]
+    area_px: int
+    score: float
+    bbox: tuple[int, int, int, int]
+    instance_id: int
+    level: Level
+    depth_m: float
+
+    @property
+    def is_false_positive(self) -> bool:
+        return self.instance_id < 0
+
+
+def _bbox(mask: NDArray[np.bool_]) -> tuple[int, int, int, int]:
+    rows = np.flatnonzero(mask.any(axis=1))
+    cols = np.flatnonzero(mask.any(axis=0))
+    return int(cols[0]), int(rows[0]), int(cols[-1]) + 1, int(rows[-1]) + 1
+
+
+def _median_depth(frame: Frame, mask: NDArray[np.bool_]) -> float:
+    values = frame.depth[mask]
+    values = values[np.isfinite(values)]
+    return float(np.median(values)) if len(values) else math.inf
+
+
+def _distort(mask: NDArray[np.bool_], background: NDArray[np.bool_], noise: NoiseModel):
+    """Erode the mask, then let it bleed into neighbouring background pixels."""
+    shaped = mask.astype(np.uint8)
+    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (3, 3))
+    if noise.mask_erosion_px:
+        shaped = cv2.erode(shaped, kernel, iterations=noise.mask_erosion_px)
+    if noise.mask_bleed_px:
+        grown = cv2.dilate(shaped, kernel, iterations=noise.mask_bleed_px).astype(bool)
+        return shaped.astype(bool) | (grown & background)
+    return shaped.astype(bool)
+
+
+def _keys(frame: Frame, world: World, level: Level, classes, parts) -> tuple[NDArray, list]:
+    """Per-pixel grouping key and the (key, label, instance) of every candidate.
+
+    Classes and parts are matched by name; names absent from this world match nothing (a
+    mission looking for trucks in a world of cars simply finds none).
+    """
+    wanted = None if classes is None else set(classes)
+    wanted_parts = None if parts is None else set(parts)
+    stride = len(world.part_names)
+    if level == "instance":
+        key = frame.instance.astype(np.int64)
+    else:
+        key = frame.instance.astype(np.int64) * stride + frame.part_id
+        key[frame.part_id == 0] = 0
+    candidates = []
+    for value in np.unique(key[key > 0]).tolist():
+        inst = value if level == "instance" else value // stride
+        info = world.instances.get(inst)
+        if info is None or (wanted is not None and info.class_name not in wanted):
+            continue
+        label = info.class_name if level == "instance" else world.part_names[value % stride]
+        if level == "instance" or wanted_parts is None or label in wanted_parts:
+            candidates.append((value, label, inst))
+    return key, candidates
+
+
+def detect(
+    frame: Frame,
+    world: World,
+    level: Level = "instance",
+    *,
+    classes: Iterable[str] | None = None,
+    parts: Iterable[str] | None = None,
+    noise: NoiseModel | None = None,
+    rng: np.random.Generator | None = None,
+) -> list[Detection]:
+    """Segment the objects (``level="instance"``) or their parts (``level="part"``).
+
+    Args:
+        classes: object classes to report (all when ``None``); for parts, the classes of the
+            objects whose parts are reported.
+        parts: part names to report (all when ``None``); ignored for objects.
+        noise: segmentation faults (``None``: ideal).
+        rng: generator for the faults; required when the noise model is not ideal.
+    """
+    if level not in ("instance", "part"):
+        raise InvalidInputError(f"detection level must be 'instance' or 'part', got {level!r}")
+    model = noise or NoiseModel()
+    generator = None if model.is_ideal else require_rng(rng)
+    key, candidates = _keys(frame, world, level, classes, parts)
+    background = frame.instance == 0
+    detections = []
+    for value, label, inst in candidates:
+        mask = key == value
+        if generator is not None:
+            mask = _distort(mask, background, model)
+        area = int(mask.sum())
+        if area < model.min_mask_area_px:
+            continue
+        depth = _median_depth(frame, mask)
+        if generator is not None and generator.random() < model.miss_chance(depth, area):
+            continue
+        score = model.score_mean
+        if generator is not None and model.score_sigma:
+            score = float(np.clip(generator.normal(model.score_mean, model.score_sigma), 0.01, 1.0))
+        detections.append(Detection(label, mask, area, score, _bbox(mask), inst, level, depth))
+    if generator is not None and model.false_positives_per_frame:
+        labels = _false_positive_labels(world, level, classes, parts)
+        detections += _false_positives(frame, labels, level, model, generator)
+    return detections
+
+
+def detect_instances(
+    frame: Frame,
+    world: World,
+    classes: Iterable[str] | None = None,
+    noise: NoiseModel | None = None,
+    rng: np.random.Generator | None = None,
+) -> list[Detection]:
+    """Object detections of the given classes (``car``, ``truck``, ``building``, ...)."""
+    return detect(frame, world, "instance", classes=classes, noise=noise, rng=rng)
+
+
+def detect_parts(
+    frame: Frame,
+    world: World,
+    noise: NoiseModel | None = None,
+    rng: np.random.Generator | None = None,
+    *,
+    classes: Iterable[str] | None = None,
+    parts: Iterable[str] | None = None,
+) -> list[Detection]:
+    """Part detections (``hood``, ``window``, ...), optionally of some object classes only."""
+    return detect(frame, world, "part", classes=classes, parts=parts, noise=noise, rng=rng)
+
+
+def _false_positive_labels(world: World, level: Level, classes, parts) -> Sequence[str]:
+    if level == "instance":
+        return (
+            sorted(classes)
+            if classes is not None
+            else sorted({i.class_name for i in world.instances.values()})
+        )
+    return sorted(parts) if parts is not None else world.part_names[1:]
+
+
+def _false_positives(
+    frame: Frame,
+    labels: Sequence[str],
+    level: Level,
+    noise: NoiseModel,
+    rng: np.random.Generator,
+) -> list[Detection]:
+    """Poisson-many random elliptical masks with made-up labels and modest scores."""
+    if not labels:
+        return []
+    height, width = frame.shape
+    result = []
+    for _ in range(int(rng.poisson(noise.false_positives_per_frame))):
+        canvas = np.zeros((height, width), dtype=np.uint8)
+        centre = (int(rng.integers(width)), int(rng.integers(height)))
+        axes = (int(rng.integers(8, 60)), int(rng.integers(8, 60)))
+        cv2.ellipse(canvas, centre, axes, float(rng.uniform(0, 180)), 0, 360, 1, -1)
+        mask = canvas.astype(bool)
+        score = float(np.clip(rng.normal(noise.false_positive_score, 0.1), 0.01, 1.0))
+        label = labels[int(rng.integers(len(labels)))]
+        area = int(mask.sum())
+        result.append(
+            Detection(label, mask, area, score, _bbox(mask), -1, level, _median_depth(frame, mask))
+        )
+    return result

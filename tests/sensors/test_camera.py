@@ -1,0 +1,138 @@
+import math
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from seminspect.core.errors import InvalidInputError
+from seminspect.core.params import preset
+from seminspect.core.rng import make_rng
+from seminspect.geometry.transforms import quat_from_yaw
+from seminspect.sensors import CameraModel, noise_preset, render
+from seminspect.sensors.noise import make_noise
+from sim_worlds import box_world, car_world
+
+SMALL = CameraModel(width=160, height=120)
+
+
+@pytest.fixture(scope="module")
+def wall():
+    """A wide wall 5 m ahead of the camera (x = 5 .. 6)."""
+    return box_world(lower=(5.0, -20.0, 0.0), upper=(6.0, 20.0, 9.0), size=(60.0, 60.0, 10.0))
+
+
+def test_intrinsics_follow_table_1() -> None:
+    camera = CameraModel()
+    assert camera.fx == pytest.approx(320 / math.tan(math.radians(69.4 / 2)))
+    assert camera.K[0, 2] == pytest.approx(319.5) and camera.K[1, 1] == camera.fx
+    assert camera.vfov_deg == pytest.approx(2 * math.degrees(math.atan(240 / camera.fx)))
+    experimental = CameraModel.from_params(preset("urban-experimental"))
+    assert experimental.hfov_deg == 86.0 and experimental.max_range == 30.0
+    half = camera.scaled(4)
+    assert (half.width, half.height, half.hfov_deg) == (160, 120, 69.4)
+
+
+@pytest.mark.parametrize(
+    "kwargs", [{"width": 0}, {"hfov_deg": 180.0}, {"max_range": -1.0}, {"width": 64.5}]
+)
+def test_impossible_cameras_are_refused(kwargs) -> None:
+    with pytest.raises(InvalidInputError):
+        CameraModel(**kwargs)
+
+
+def test_depth_is_measured_along_the_optical_axis(wall) -> None:
+    frame = render(wall, SMALL, (0.0, 0.0, 2.0), quat_from_yaw(0.0))
+    hit = frame.instance > 0
+    assert hit.mean() > 0.8  # the rest is ground in front of the wall
+    np.testing.assert_allclose(frame.depth[hit], 5.0, atol=1e-4)
+    points = frame.points(hit)
+    np.testing.assert_allclose(points[:, 0], 5.0, atol=1e-4)
+    # the image's left edge sees +y, its top edge sees +z
+    assert points[:10, 1].mean() > 0 and frame.points()[:, 2].max() > 3.0
+
+
+def test_range_limit_and_pitch(wall) -> None:
+    far = render(wall, CameraModel(160, 120, max_range=4.0), (0, 0, 2), quat_from_yaw(0.0))
+    seen = np.isfinite(far.depth)
+    assert not (far.instance > 0).any() and far.depth[seen].max() <= 4.0
+    assert (far.class_id[~seen] == 0).all() and (far.face[~seen] == -1).all()
+    down = Rotation.from_euler("ZY", [0.0, math.pi / 2]).as_quat()
+    floor = render(wall, SMALL, (0.0, 0.0, 2.0), down)
+    np.testing.assert_allclose(floor.depth, 2.0, atol=1e-4)
+    assert (floor.class_id == wall.class_id("ground")).all()
+
+
+def test_labels_per_pixel() -> None:
+    world = car_world()
+    frame = render(
+        world, SMALL, (1.5, 0.0, 6.0), Rotation.from_euler("ZY", [0, math.pi / 2]).as_quat()
+    )
+    centre = frame.part_id[60, 80]
+    assert world.part_names[centre] == "hood"
+    assert world.class_names[frame.class_id[60, 80]] == "car" and frame.instance[60, 80] == 1
+    assert (frame.face[frame.instance == 0] >= -1).all()
+    assert np.all(world.face_part[frame.face[frame.face >= 0]] == frame.part_id[frame.face >= 0])
+
+
+def test_rendering_is_deterministic_and_noise_is_seeded(wall) -> None:
+    pose = ((0.0, 1.0, 1.5), quat_from_yaw(0.3))
+    a, b = render(wall, SMALL, *pose), render(wall, SMALL, *pose)
+    np.testing.assert_array_equal(a.depth, b.depth)
+    np.testing.assert_array_equal(a.intensity, b.intensity)
+    noise = noise_preset("realistic")
+    n1 = render(wall, SMALL, *pose, noise=noise, rng=make_rng(4, "camera"))
+    n2 = render(wall, SMALL, *pose, noise=noise, rng=make_rng(4, "camera"))
+    n3 = render(wall, SMALL, *pose, noise=noise, rng=make_rng(5, "camera"))
+    np.testing.assert_array_equal(n1.depth, n2.depth)
+    assert not np.array_equal(n1.depth, n3.depth)
+    np.testing.assert_array_equal(n1.instance, a.instance)  # labels carry no noise
+    with pytest.raises(InvalidInputError, match="random generator"):
+        render(wall, SMALL, *pose, noise=noise)
+
+
+def test_depth_noise_grows_with_range(wall) -> None:
+    noise = make_noise({"depth_noise_m": 0.01, "depth_noise_per_m": 0.02})
+    spreads = []
+    for distance in (2.0, 4.5):
+        pose = ((5.0 - distance, 0.0, 2.0), quat_from_yaw(0.0))
+        clean = render(wall, SMALL, *pose)
+        noisy = render(wall, SMALL, *pose, noise=noise, rng=make_rng(0, "d"))
+        hit = clean.instance > 0
+        error = noisy.depth[hit] - clean.depth[hit]
+        spreads.append(float(np.std(error)))
+        assert abs(np.mean(error)) < 0.01
+        assert spreads[-1] == pytest.approx(noise.depth_sigma(distance), rel=0.1)
+    assert spreads[1] > 1.5 * spreads[0]
+
+
+def test_intensity_noise_only_touches_the_image(wall) -> None:
+    pose = ((0.0, 0.0, 2.0), quat_from_yaw(0.0))
+    clean = render(wall, SMALL, *pose)
+    noisy = render(wall, SMALL, *pose, noise=make_noise({"intensity_noise": 5.0}), rng=make_rng(1))
+    delta = noisy.intensity.astype(float) - clean.intensity
+    assert 3.0 < delta.std() < 6.0
+    np.testing.assert_array_equal(noisy.depth, clean.depth)
+
+
+def test_strided_render_and_odometry_tagging(wall) -> None:
+    full = render(wall, CameraModel(), (0.0, 0.0, 2.0), quat_from_yaw(0.0))
+    coarse = render(wall, CameraModel(), (0.0, 0.0, 2.0), quat_from_yaw(0.0), stride=4)
+    assert coarse.shape == (120, 160) and coarse.camera.hfov_deg == full.camera.hfov_deg
+    assert np.isfinite(coarse.depth).mean() == pytest.approx(
+        np.isfinite(full.depth).mean(), abs=0.02
+    )
+    tagged = render(
+        wall,
+        SMALL,
+        (0.0, 0.0, 2.0),
+        quat_from_yaw(0.0),
+        odometry=((0.0, 0.5, 2.0), quat_from_yaw(0.0)),
+    )
+    shift = tagged.points(use_odometry=True) - tagged.points()
+    np.testing.assert_allclose(shift, np.tile([0.0, 0.5, 0.0], (len(shift), 1)), atol=1e-6)
+    with pytest.raises(InvalidInputError, match="mask shape"):
+        tagged.points(np.ones((3, 3), bool))
+    with pytest.raises(InvalidInputError):
+        render(wall, SMALL, (0.0, 0.0, math.nan), quat_from_yaw(0.0))
+    with pytest.raises(InvalidInputError):
+        render(wall, SMALL, (0.0, 0.0, 2.0), quat_from_yaw(0.0), stride=0)
