@@ -188,3 +188,23 @@ def test_rays_along_cell_edges_still_occupy_their_end(start, end) -> None:
     grid = VoxelMap.empty([0, 0, 0], [5, 5, 5], 1.0)
     grid.integrate_rays(start, [end], [True])
     assert grid.state_at(end) == OCCUPIED
+
+
+def test_lidar_misses_clear_free_space_only_when_asked() -> None:
+    from seminspect.sensors import Lidar
+    from seminspect.worlds import generate_world
+
+    world = generate_world("city", "small", seed=0)
+    start = world.start_position + np.array([0.0, 0.0, 0.7])
+    scan = Lidar(max_range=30.0).scan(world, start, [0, 0, 0, 1])
+    assert len(scan.misses) > 0  # upward beams see open sky
+    plain = VoxelMap.covering(world, 0.5)
+    plain.integrate_scan(scan)
+    cleared = VoxelMap.covering(world, 0.5)
+    cleared.integrate_scan(scan, clear_misses_to=20.0)
+    assert cleared.counts()["free"] > plain.counts()["free"]
+    assert cleared.counts()["occupied"] == plain.counts()["occupied"]
+    above = start + np.array([10.0, 0.0, 2.4])  # open sky, on a 13-degree beam
+    assert plain.state_at([above])[0] == UNKNOWN and cleared.state_at([above])[0] == FREE
+    with pytest.raises(InvalidInputError, match="clear_misses_to"):
+        cleared.integrate_scan(scan, clear_misses_to=50.0)

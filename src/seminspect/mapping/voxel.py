@@ -189,9 +189,22 @@ class VoxelMap:
         ends = position + (directions[flat] * length[:, None]) @ rotation.T
         self.integrate_rays(position, ends, hit)
 
-    def integrate_scan(self, scan: LidarScan) -> None:
-        """Integrate the returns of a LiDAR scan (each clears its ray and marks its end)."""
+    def integrate_scan(self, scan: LidarScan, clear_misses_to: float | None = None) -> None:
+        """Integrate a LiDAR scan: each return clears its ray and marks its end occupied.
+
+        With ``clear_misses_to`` (metres, at most the sensor's range), beams that returned
+        nothing also clear free space out to that distance, as OctoMap's max-range insertion
+        does: open sky and far, empty streets become known free rather than staying unknown.
+        """
         self.integrate_rays(scan.origin, scan.points, np.ones(len(scan.points), dtype=bool))
+        if clear_misses_to is None or not len(scan.misses):
+            return
+        if not (math.isfinite(clear_misses_to) and 0 < clear_misses_to <= scan.max_range):
+            raise InvalidInputError(
+                f"clear_misses_to must be in (0, {scan.max_range}] m, got {clear_misses_to}"
+            )
+        ends = scan.origin + scan.misses.astype(np.float64) * clear_misses_to
+        self.integrate_rays(scan.origin, ends, np.zeros(len(ends), dtype=bool))
 
     def inflated(self, radius: float) -> VoxelMap:
         """A copy where every cell within ``radius`` of an occupied cell is occupied.

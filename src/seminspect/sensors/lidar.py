@@ -9,7 +9,7 @@ frame.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
@@ -24,7 +24,7 @@ from seminspect.worlds import World
 
 @dataclass(eq=False)
 class LidarScan:
-    """Labelled points of one scan (only returns; rays that hit nothing are dropped).
+    """Labelled points of one scan, and the directions of the beams that returned nothing.
 
     Attributes:
         points: ``(N, 3)`` world coordinates of the returns.
@@ -32,6 +32,10 @@ class LidarScan:
         ring: beam index (0 = lowest) per point.
         origin: the sensor position.
         stamp: time of the scan (seconds).
+        misses: ``(M, 3)`` world unit directions of the beams with no return within
+            ``max_range``; mappers may clear free space along them (see
+            :meth:`~seminspect.mapping.voxel.VoxelMap.integrate_scan`).
+        max_range: the sensor's range (metres).
     """
 
     points: NDArray[np.float64]
@@ -41,6 +45,8 @@ class LidarScan:
     ring: NDArray[np.int16]
     origin: Vec3
     stamp: float = 0.0
+    misses: NDArray[np.float32] = field(default_factory=lambda: np.empty((0, 3), np.float32))
+    max_range: float = math.inf
 
 
 @dataclass(frozen=True)
@@ -113,4 +119,6 @@ class Lidar:
             ring=ring[hit],
             origin=origin,
             stamp=float(stamp),
+            misses=directions[~hit],
+            max_range=self.max_range,
         )

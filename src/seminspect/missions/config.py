@@ -1,0 +1,138 @@
+"""Mission configuration: typed, validated, with defaults per world.
+
+A :class:`MissionConfig` says everything a run depends on; the run directory keeps its resolved
+form (every default filled in), so a run can be repeated from its ``config.json``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from seminspect.core.config import build
+from seminspect.core.params import PRESETS, InspectionParams, PresetName
+
+Mode = Literal["ground", "aerial"]
+NoiseName = Literal["ideal", "realistic"]
+PlannerName = Literal["hierarchical", "volumetric"]
+
+VEHICLE_CLASSES = ("car", "truck")
+VEHICLE_FEATURES = (
+    "hood", "trunk", "front-bumper", "back-bumper", "front-glass", "back-glass",
+    "front-left-door", "front-right-door", "back-left-door", "back-right-door",
+    "front-left-wheel", "front-right-wheel", "back-left-wheel", "back-right-wheel",
+    "front-left-light", "front-right-light", "back-left-light", "back-right-light",
+)  # fmt: skip
+BUILDING_FEATURES = ("window", "person", "rubble")
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+
+class RobotConfig(_Strict):
+    """The platform (a legged robot by default, as in 000 Sec VI-A)."""
+
+    radius: float = Field(0.4, gt=0, le=3, description="body radius for collisions [m]")
+    speed: float = Field(1.0, gt=0, le=10, description="speed limit [m/s]")
+    yaw_rate: float = Field(0.8, gt=0, le=5, description="turn-rate limit [rad/s]")
+    body_height: float = Field(
+        0.7, gt=0, le=5, description="camera height (ground) or take-off height (aerial) [m]"
+    )
+    flight_height: float = Field(2.0, gt=0, le=50, description="height of Level-0 (aerial) [m]")
+
+
+class InspectionConfig(_Strict):
+    """FLIE's local view planner (002 eqs 1-2) and level completion (000 eq 8)."""
+
+    d_view: float = Field(2.5, gt=0.3, le=20, description="viewing distance [m]")
+    overlap_h: float = Field(0.6, ge=0, lt=1, description="horizontal image overlap γ_H")
+    overlap_v: float = Field(0.6, ge=0, lt=1, description="vertical image overlap γ_V")
+    max_poses_per_level: int = Field(60, ge=3, description="safety cap on poses in one level")
+    max_levels: int = Field(6, ge=1, description="cap on levels per target (aerial)")
+    save_images: bool = Field(True, description="write view images to the run directory")
+
+
+class ExplorationConfig(_Strict):
+    """The exploration behaviours: 360-degree surveys and frontier hops."""
+
+    survey_overlap: float = Field(
+        0.1, ge=0, lt=0.9, description="overlap of consecutive survey images"
+    )
+    frontier_min_cells: int = Field(12, ge=1, description="smallest frontier worth visiting")
+    frontier_max_hops: int = Field(40, ge=0, description="cap on frontier hops per mission")
+    lidar_every_m: float = Field(2.0, gt=0, description="LiDAR scan spacing while driving [m]")
+    camera_every_m: float = Field(4.0, gt=0, description="camera frame spacing while driving [m]")
+
+
+class MissionConfig(_Strict):
+    """One xFLIE mission. ``None`` fields take the world's default (see :func:`resolve`)."""
+
+    world: str = "city"
+    scenario: str | None = "medium"
+    seed: int = Field(0, ge=0)
+    preset: PresetName | None = None
+    mode: Mode | None = None
+    noise: NoiseName = "realistic"
+    planner: PlannerName = "hierarchical"
+    time_budget_s: float | None = Field(None, gt=0, description="simulated seconds")
+    map_resolution: float = Field(0.3, ge=0.1, le=1.0, description="robot's occupancy map [m]")
+    target_classes: tuple[str, ...] | None = None
+    feature_labels: tuple[str, ...] | None = None
+    localisation: Literal["median", "cluster"] = "cluster"
+    robot: RobotConfig = RobotConfig()
+    inspection: InspectionConfig | None = None
+    exploration: ExplorationConfig = ExplorationConfig()
+
+
+#: 000 Sec VII-D: time limits of 700, 1400 and 2800 s for the 5, 10 and 20-vehicle scenarios.
+CITY_BUDGETS = {"small": 700.0, "medium": 1400.0, "large": 2800.0}
+
+#: Per-world defaults: preset, mode, target classes, features, viewing distance, budget.
+WORLD_DEFAULTS: dict[str, dict[str, Any]] = {
+    "city": {"preset": "urban-simulated", "mode": "ground", "d_view": 2.5, "budget": 1400.0},
+    "campus": {"preset": "urban-experimental", "mode": "ground", "d_view": 2.5, "budget": 900.0},
+    "subterranean": {
+        "preset": "urban-experimental", "mode": "ground", "d_view": 1.3, "budget": 400.0,
+    },
+    "collapsed-buildings": {
+        "preset": "collapsed-buildings", "mode": "aerial", "d_view": 4.0, "budget": 2400.0,
+        "classes": ("building",), "features": BUILDING_FEATURES,
+    },
+}  # fmt: skip
+
+
+def make_config(values: dict[str, Any]) -> MissionConfig:
+    """Validate raw values (e.g. from the CLI or a JSON file) with one readable error line."""
+    return build(MissionConfig, values, "mission setting")
+
+
+def resolve(config: MissionConfig) -> MissionConfig:
+    """Fill every ``None`` field with the world's default."""
+    defaults = WORLD_DEFAULTS.get(config.world, WORLD_DEFAULTS["city"])
+    budget = defaults["budget"]
+    if config.world == "city" and config.scenario in CITY_BUDGETS:
+        budget = CITY_BUDGETS[config.scenario]
+    inspection = config.inspection or InspectionConfig(d_view=defaults["d_view"])
+    return config.model_copy(
+        update={
+            "preset": config.preset or defaults["preset"],
+            "mode": config.mode or defaults["mode"],
+            "time_budget_s": config.time_budget_s or budget,
+            "target_classes": config.target_classes or defaults.get("classes", VEHICLE_CLASSES),
+            "feature_labels": config.feature_labels or defaults.get("features", VEHICLE_FEATURES),
+            "inspection": inspection,
+        }
+    )
+
+
+def inspection_params(config: MissionConfig) -> InspectionParams:
+    """The Table 1/2 parameters of a resolved configuration."""
+    return PRESETS[config.preset or "urban-simulated"]
+
+
+def survey_headings(fov_deg: float, overlap: float) -> int:
+    """How many views a 360-degree survey takes with this field of view and overlap."""
+    return max(3, math.ceil(360.0 / (fov_deg * (1.0 - overlap))))
