@@ -54,3 +54,10 @@ def test_nothing_to_select_and_ties_keep_registration_order() -> None:
     assert select_target(LayeredSemanticGraph()) == (None, [])
     best, _ = select_target(graph_with((10, 0, 100), (-10, 0, 100)))
     assert best is not None and best.target_id == "car-0"
+
+
+def test_excluded_targets_are_not_candidates() -> None:
+    graph = graph_with((10, 0, 30720), (0, 20, 3072))
+    best, terms = select_target(graph, exclude={"car-0"})
+    assert best is not None and best.target_id == "car-1" and len(terms) == 1
+    assert terms[0].centrality == 0.0  # the only candidate left

@@ -23,6 +23,7 @@ from seminspect.core.errors import SeminspectError
 #: (module under seminspect.cli, group name, one-line help)
 #: Group modules import heavy dependencies inside their commands so ``--help`` stays fast.
 GROUPS: tuple[tuple[str, str, str], ...] = (
+    ("mission", "mission", "Run an xFLIE inspection mission on a simulated site (paper 000)."),
     ("graph", "graph", "Inspect, query and export 3D Layered Semantic Graphs."),
     ("terrain", "terrain", "Terrain-aware, task-driven outdoor scene graphs (paper 001)."),
     ("world", "world", "List, draw and export the built-in simulated worlds."),

@@ -82,6 +82,18 @@ class MissionConfig(_Strict):
     target_classes: tuple[str, ...] | None = None
     feature_labels: tuple[str, ...] | None = None
     localisation: Literal["median", "cluster"] = "cluster"
+    min_score: float = Field(
+        0.6, ge=0, le=1, description="segmentation confidence below which detections are ignored"
+    )
+    mask_erosion_px: int = Field(
+        2, ge=0, le=20, description="erosion of object masks before localisation (000 Sec VIII)"
+    )
+    gamma_thresh: float | None = Field(
+        None, ge=0, description="Γ_thresh of eq (8); None: the ORB matcher's calibration"
+    )
+    odometry_drift_per_m: float | None = Field(
+        None, ge=0, le=1, description="localisation drift [m per sqrt(m)]; None: see mission_noise"
+    )
     robot: RobotConfig = RobotConfig()
     inspection: InspectionConfig | None = None
     exploration: ExplorationConfig = ExplorationConfig()

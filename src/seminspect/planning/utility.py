@@ -17,7 +17,7 @@ The paper leaves two cases undefined; both get finite values here:
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -67,13 +67,16 @@ def utility_terms(
     ]
 
 
-def select_target(graph: LayeredSemanticGraph) -> tuple[UtilityTerms | None, list[UtilityTerms]]:
+def select_target(
+    graph: LayeredSemanticGraph, exclude: Collection[str] = ()
+) -> tuple[UtilityTerms | None, list[UtilityTerms]]:
     """``v_D* = argmax U(v_D)`` over the detected targets (ties: the earliest registered).
 
     Stores each candidate's utility on its node (the attribute ``U`` of 000 Sec IV-A) and
     returns the winner (None when nothing is left to inspect) with every candidate's terms.
+    Targets in ``exclude`` (e.g. found unreachable) are not candidates.
     """
-    candidates = graph.targets(TargetStatus.DETECTED)
+    candidates = [t for t in graph.targets(TargetStatus.DETECTED) if t.id not in exclude]
     terms = utility_terms(graph.robot.position, candidates, graph.params)
     for node, term in zip(candidates, terms, strict=True):
         node.utility = term.utility

@@ -154,3 +154,52 @@ def test_connect_targets_weighs_the_via_polyline() -> None:
     assert edge.weight == pytest.approx(17 + 7)
     assert (edge.u, edge.v) == ("car-0", "truck-1")
     np.testing.assert_allclose(edge.via, [[0.0, 0.0, 0.7]])
+
+
+def test_discarding_a_false_detection_removes_it_everywhere() -> None:
+    graph = small_graph()
+    before = graph.population()
+    graph.discard_target("truck-1")
+    after = graph.population()
+    assert "truck-1" not in graph and [t.id for t in graph.targets()] == ["car-0"]
+    assert graph.edge("robot", "truck-1") is None
+    assert (after.unified.nodes, after.unified.edges) == (
+        before.unified.nodes - 1,
+        before.unified.edges - 1,
+    )
+    with pytest.raises(InvalidInputError, match="only detected targets"):
+        graph.discard_target("car-0")
+    graph.register_target(Observation([0, 20, 0.7], label="truck", score=0.9, mask_area=10))
+    graph.optimise_targets()
+    assert graph.targets()[-1].id == "truck-2"  # numbers are never reused
+
+
+def test_finishing_an_inspection_prunes_its_earlier_re_detections() -> None:
+    graph = LayeredSemanticGraph(robot_position=[0, 0, 0.7])
+    for x, y, area in ((9.0, 0.4, 5000), (15.5, 0.0, 400), (30.0, 0.0, 900)):
+        graph.register_target(Observation([x, y, 0.7], label="car", score=0.9, mask_area=area))
+    graph.optimise_targets()  # car-1 sits 6.5 m from car-0's estimate: not merged then
+    graph.begin_inspection("car-0", Observation.view_pose([7.0, 0.0, 0.7]))
+    for x, y in ((10, -5), (17, -5), (17, 5), (10, 5)):  # a long vehicle, seen all round
+        graph.register_pose(Observation.view_pose([x, y, 0.7]))
+    graph.finish_inspection()
+    assert graph.pruned == ("car-1",)  # inside the containment polygon
+    assert [t.id for t in graph.targets()] == ["car-0", "car-2"]
+
+
+def test_an_inspection_too_short_for_a_polygon_is_cancelled() -> None:
+    graph = LayeredSemanticGraph(robot_position=[0, 0, 0.7])
+    graph.register_target(Observation([9.0, 0.0, 0.7], label="car", score=0.9, mask_area=500))
+    graph.optimise_targets()
+    before = graph.population()
+    graph.begin_inspection("car-0", Observation.view_pose([7.0, 0.0, 0.7]))
+    graph.register_pose(Observation.view_pose([7.0, 1.0, 0.7]))
+    graph.register_feature(Observation([9.0, 0.5, 0.8], label="hood", score=0.8, mask_area=10))
+    assert graph.abort_inspection() is None
+    car = graph.target("car-0")
+    assert car.status is TargetStatus.DETECTED and car.levels == [] and graph.inspecting is None
+    assert graph.population() == before
+    graph.begin_inspection("car-0", Observation.view_pose([7.0, 0.0, 0.7]))  # can start again
+    for x, y in RING:
+        graph.register_pose(Observation.view_pose([x, y, 0.7]))
+    assert graph.abort_inspection() is car and car.inspected

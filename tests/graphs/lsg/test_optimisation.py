@@ -72,6 +72,19 @@ def test_polygon_of_a_target_behind_the_robot_is_not_checked() -> None:
     )
 
 
+def test_a_long_target_is_in_view_when_part_of_its_polygon_is() -> None:
+    truck = InspectedView(
+        "truck-1", np.array([10.0, 8.0, 0.0]), np.array([[3, 6], [17, 6], [17, 10], [3, 10.0]])
+    )  # centre 38.7 deg off axis; its near end inside the 34.7 deg half field of view
+    views = inspected_in_view(
+        [truck], robot_position=ORIGIN, robot_yaw=0.0, d_max=30.0, fov_rad=FOV
+    )
+    assert [v.target_id for v in views] == ["truck-1"]
+    assert (
+        run([detection(5, 8)], inspected=[truck], near=False)[0].outcome is Outcome.INSIDE_POLYGON
+    )
+
+
 def test_view_set_uses_range_and_half_fov() -> None:
     far = InspectedView("far", np.array([40.0, 0.0, 0.0]), None)
     side = InspectedView("side", np.array([10.0, 7.5, 0.0]), None)  # 36.9 deg off axis

@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.names import unknown_name
 from seminspect.core.params import PRESETS, InspectionParams
-from seminspect.geometry.polygons import polygon_centroid, ring_polygon
+from seminspect.geometry.polygons import polygon_centroid, polygon_contains, ring_polygon
 from seminspect.geometry.transforms import IDENTITY_QUAT, as_point, as_quaternion, yaw_from_quat
 from seminspect.graphs.lsg import naming
 from seminspect.graphs.lsg.model import (
@@ -165,6 +165,8 @@ class LayeredSemanticGraph:
         self._edges: dict[tuple[str, str], Edge] = {}
         self._pending: list[Observation] = []
         self._inspection: _Inspection | None = None
+        #: Detected targets removed by the last :meth:`finish_inspection`.
+        self.pruned: tuple[str, ...] = ()
         self.next_target_index = 0
         #: Incremented on every change; planners use it to invalidate their caches.
         self.revision = 0
@@ -304,6 +306,22 @@ class LayeredSemanticGraph:
             target.mask_area = z.mask_area
             target.image = z.image
             target.stamp = z.stamp
+
+    def discard_target(self, target_id: str) -> TargetNode:
+        """Remove a detected (uninspected) target found to be invalid, e.g. a false detection
+        that is not there when the robot comes to look; Φ's removal of invalid nodes (eq 4)."""
+        target = self.target(target_id)
+        if target.inspected or target is self.inspecting:
+            raise InvalidInputError(
+                f"{target.id} is inspected; only detected targets are discarded"
+            )
+        for key in [k for k in self.target_graph.edges if target.id in k]:
+            del self.target_graph.edges[key]
+            del self._edges[key]
+        del self.target_graph.nodes[target.id]
+        del self._nodes[target.id]
+        self.revision += 1
+        return target
 
     def connect_targets(self, a: str, b: str, via: ArrayLike | None = None) -> Edge:
         """Spatial ``v_I - v_I`` edge between two inspected targets.
@@ -482,7 +500,10 @@ class LayeredSemanticGraph:
 
         The polygon's vertices are the pose nodes of the first level (000 Sec V-B); the target's
         position moves to the polygon's centroid (height unchanged). With fewer than three
-        distinct poses there is no polygon and the position is left as detected.
+        distinct poses there is no polygon and the position is left as detected. Detected
+        targets that the polygon now contains, or that lie within ``d_check^T`` of the refined
+        position, are re-detections of this target and are removed (000 Fig 17f);
+        :attr:`pruned` lists them.
         """
         inspection = self._require_inspection()
         self.close_level()
@@ -495,12 +516,56 @@ class LayeredSemanticGraph:
             target.position = np.array([centre[0], centre[1], target.position[2]])
         target.status = TargetStatus.INSPECTED
         self._inspection = None
+        self.pruned = self._prune_covered(target)
         self.revision += 1
         return target
 
+    def _prune_covered(self, target: TargetNode) -> tuple[str, ...]:
+        covered = []
+        for other in self.targets(TargetStatus.DETECTED):
+            near = np.linalg.norm(other.position - target.position) <= self.params.d_check_T
+            inside = (
+                target.polygon is not None
+                and polygon_contains(target.polygon, other.position[:2])[0]
+            )
+            if near or inside:
+                covered.append(other.id)
+        for target_id in covered:
+            self.discard_target(target_id)
+        return tuple(covered)
+
     def abort_inspection(self) -> TargetNode | None:
-        """Close the level in progress and finish the inspection with what was gathered."""
-        return self.finish_inspection() if self._inspection is not None else None
+        """End an inspection cut short: finish it with what was gathered when its first level
+        has enough poses for a containment polygon, otherwise cancel it."""
+        if self._inspection is None:
+            return None
+        first = self.entry_level(self._inspection.target)
+        if ring_polygon([p.position[:2] for p in first.poses]) is None:
+            self.cancel_inspection()
+            return None
+        return self.finish_inspection()
+
+    def cancel_inspection(self) -> TargetNode:
+        """Undo the inspection in progress: its levels, poses and features leave the graph and
+        the target is a detected one again."""
+        inspection = self._require_inspection()
+        target = inspection.target
+        assert target.level_graph is not None
+        removed = {target.id: False}
+        for level in target.levels:
+            removed[level.id] = True
+            for pose in level.poses:
+                removed[pose.id] = True
+                removed.update((f.id, True) for f in pose.features)
+        for key in [k for k in self._edges if removed.get(k[0]) or removed.get(k[1])]:
+            del self._edges[key]
+        for node_id, gone in removed.items():
+            if gone:
+                del self._nodes[node_id]
+        target.level_graph = None
+        self._inspection = None
+        self.revision += 1
+        return target
 
     def _require_inspection(self) -> _Inspection:
         if self._inspection is None:

@@ -66,14 +66,20 @@ def inspected_in_view(
     """``V_I,wsr`` of eq (4): inspected targets within ``d_max`` of the robot and inside the FOV.
 
     The paper writes ``θ_vI <= α`` with α the full field of view; the viewing angle is measured
-    from the optical axis here, so a target is in view when ``|θ| <= α / 2``.
+    from the optical axis here, so a point is in view when ``|θ| <= α / 2``. An inspected
+    target is in view when its centre or any vertex of its containment polygon is: seen from
+    close by, an 8 m truck can fill one side of the image while its centre lies outside it.
     """
     half_fov = 0.5 * fov_rad
+
+    def visible(view: InspectedView) -> bool:
+        points = [view.position[:2]] + ([] if view.polygon is None else list(view.polygon))
+        return any(bearing_offset(robot_position, robot_yaw, p) <= half_fov for p in points)
+
     return [
         view
         for view in inspected
-        if np.linalg.norm(view.position - robot_position) <= d_max
-        and bearing_offset(robot_position, robot_yaw, view.position) <= half_fov
+        if np.linalg.norm(view.position - robot_position) <= d_max and visible(view)
     ]
 
 

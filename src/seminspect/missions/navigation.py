@@ -1,0 +1,206 @@
+"""Driving the robot: routes on its own map, sensing on the way, and exploration frontiers.
+
+:class:`Navigator` follows a route in steps, scanning with the LiDAR every ``lidar_every_m``
+metres and handing a camera frame to the mission every ``camera_every_m`` (so targets are found
+in transit). Before each step it re-checks the route against the map it has just updated, and
+asks the local planner for a new route when the old one now crosses an obstacle.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy import ndimage
+
+from seminspect.core.errors import PlanningError
+from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap
+from seminspect.missions.platform import Platform
+from seminspect.planning.gridmap import CostGrid, planar_states
+from seminspect.planning.local import LocalPlanner
+from seminspect.sensors import Frame
+
+#: Metres a goal may be missed by when the robot already stands within the goal radius plus this.
+ARRIVAL_SLACK = 0.05
+
+
+@dataclass
+class NavigationStats:
+    """Counters and timings of everything the navigator planned and drove."""
+
+    local_plans: int = 0
+    local_failures: int = 0
+    local_planning_s: list[float] = field(default_factory=list)
+    replans: int = 0
+    blocked: int = 0
+
+
+class Navigator:
+    """Drives a platform along routes planned on its occupancy map.
+
+    Args:
+        platform: the robot.
+        occupancy: the robot's own map, updated here from LiDAR scans.
+        planner: the local planner (routes may enter unknown space at a cost).
+        on_frame: called with every camera frame taken while driving.
+        lidar_every_m, camera_every_m: sensing intervals while driving.
+        clear_misses_to: free space is cleared along LiDAR beams with no return up to this range.
+    """
+
+    def __init__(
+        self,
+        platform: Platform,
+        occupancy: VoxelMap,
+        planner: LocalPlanner,
+        on_frame: Callable[[Frame], None],
+        *,
+        lidar_every_m: float,
+        camera_every_m: float,
+        clear_misses_to: float,
+    ) -> None:
+        self.platform = platform
+        self.occupancy = occupancy
+        self.planner = planner
+        self.on_frame = on_frame
+        self.lidar_every_m = lidar_every_m
+        self.camera_every_m = camera_every_m
+        self.clear_misses_to = clear_misses_to
+        self.stats = NavigationStats()
+        self._since_camera = 0.0
+
+    # ----------------------------------------------------------------- sensing
+    def sense_lidar(self) -> None:
+        self.occupancy.integrate_scan(self.platform.scan(), clear_misses_to=self.clear_misses_to)
+
+    def _grid(self) -> CostGrid:
+        return CostGrid.build(self.occupancy, self.planner.model, self.planner.band, lazy=True)
+
+    def segment_is_free(self, a: ArrayLike, b: ArrayLike, grid: CostGrid | None = None) -> bool:
+        """Whether the robot's map lets it drive straight from ``a`` to ``b`` (unknown allowed)."""
+        return (grid or self._grid()).segment_is_free(a, b)
+
+    # ----------------------------------------------------------------- driving
+    def drive(self, waypoints: NDArray[np.float64], final_yaw: float | None = None) -> bool:
+        """Follow ``waypoints`` (the first is where the robot stands). False if the route became
+        blocked or the robot was stopped; True when it reached the last waypoint."""
+        for target in waypoints[1:]:
+            if not self._drive_segment(np.asarray(target, dtype=np.float64)):
+                return False
+        if final_yaw is not None:
+            self.platform.turn_to(final_yaw)
+        return True
+
+    def _drive_segment(self, target: NDArray[np.float64]) -> bool:
+        while True:
+            here = self.platform.position
+            gap = float(np.linalg.norm((target - here)[:2]))
+            if gap < 1e-3 and abs(target[2] - here[2]) < 1e-3:
+                return True
+            if not self._clear_ahead(here, target, gap):
+                self.stats.replans += 1
+                return False
+            step = min(gap, self.lidar_every_m) if gap > 0 else 0.0
+            point = target if step == gap else here + (target - here) * (step / gap)
+            heading = math.atan2(target[1] - here[1], target[0] - here[0]) if gap > 0.2 else None
+            motion = self.platform.move_to(point, heading)
+            self.sense_lidar()
+            self._since_camera += motion.distance
+            if self._since_camera >= self.camera_every_m:
+                self._since_camera = 0.0
+                self.on_frame(self.platform.capture())
+            if motion.blocked:
+                self.stats.blocked += 1
+                return False
+
+    def _clear_ahead(
+        self, here: NDArray[np.float64], target: NDArray[np.float64], gap: float
+    ) -> bool:
+        """The segment is free, or free once past the inflation margin the robot may stand in
+        (after a close view; the planner starts such routes from the nearest free cell)."""
+        grid = self._grid()
+        if self.segment_is_free(here, target, grid):
+            return True
+        escape = self.planner.model.robot_radius + self.occupancy.resolution
+        if gap <= escape:  # stepping out of the margin to the planner's first free cell
+            return self.segment_is_free(target, target, grid)
+        return self.segment_is_free(here + (target - here) * (escape / gap), target, grid)
+
+    def go_to(
+        self,
+        goal: ArrayLike,
+        radius: float,
+        final_yaw: float | None = None,
+        attempts: int = 5,
+    ) -> bool:
+        """Plan and drive to within ``radius`` of ``goal``, replanning as the map grows."""
+        goal_point = np.asarray(goal, dtype=np.float64)
+        for _ in range(attempts):
+            if self._arrived(goal_point, radius):
+                break
+            self.stats.local_plans += 1
+            try:
+                path = self.planner.plan(self.occupancy, self.platform.position, goal_point, radius)
+            except PlanningError:
+                self.stats.local_failures += 1
+                return False
+            self.stats.local_planning_s.append(path.planning_time)
+            if self.drive(path.waypoints):
+                break
+        arrived = self._arrived(goal_point, radius)
+        if arrived and final_yaw is not None:
+            self.platform.turn_to(final_yaw)
+        return arrived
+
+    def _arrived(self, goal: NDArray[np.float64], radius: float) -> bool:
+        here = self.platform.position
+        horizontal = float(np.linalg.norm((goal - here)[:2]))
+        if self.planner.mode == "ground":
+            return horizontal <= radius + ARRIVAL_SLACK
+        return float(np.linalg.norm(goal - here)) <= radius + ARRIVAL_SLACK
+
+
+@dataclass(frozen=True)
+class Frontier:
+    """A boundary between known free and unknown space, at the robot's height."""
+
+    goal: NDArray[np.float64]
+    cells: int
+
+
+def find_frontiers(
+    occupancy: VoxelMap,
+    band: tuple[float, float],
+    min_cells: int,
+    height: float,
+    wall_clearance: float = 1.0,
+) -> list[Frontier]:
+    """Frontiers of the map's height band: free cells touching unknown ones, grouped.
+
+    Free cells closer than ``wall_clearance`` to an obstacle are left out: along a wall the
+    unknown side is the inside of a building, which no visit can reveal. Each group's goal is
+    its cell closest to the group's mean, lifted to ``height``.
+    """
+    layer = planar_states(occupancy, band)[:, :, 0]
+    free = layer == FREE
+    touching = ndimage.binary_dilation(
+        layer == UNKNOWN, structure=ndimage.generate_binary_structure(2, 1)
+    )
+    open_space = ndimage.distance_transform_edt(layer != OCCUPIED) * occupancy.resolution
+    frontier = free & touching & (open_space > wall_clearance)
+    labels, count = ndimage.label(frontier, structure=np.ones((3, 3), dtype=bool))
+    if count == 0:
+        return []
+    sizes = np.bincount(labels.ravel())
+    found = []
+    for group in np.flatnonzero(sizes >= min_cells):
+        if group == 0:
+            continue
+        cells = np.argwhere(labels == group)
+        centre = cells.mean(axis=0)
+        pick = cells[np.argmin(((cells - centre) ** 2).sum(axis=1))]
+        xy = occupancy.origin[:2] + (pick + 0.5) * occupancy.resolution
+        found.append(Frontier(np.array([xy[0], xy[1], height]), int(sizes[group])))
+    return found

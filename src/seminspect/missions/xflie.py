@@ -1,0 +1,627 @@
+"""The xFLIE executive: explore, select, navigate, inspect and remember (000 Sec V).
+
+One mission, step by step:
+
+1. ``π^expl:360``: a 360-degree survey where the robot stands. Every frame's target
+   detections are registered (eq 3) and the Target layer is optimised and merged (eqs 4-5).
+2. Target selection by utility (eq 6). Navigation: the hierarchical planner over the 3DLSG for
+   the known part of the route (to the inspected target nearest the goal), then the local
+   planner on the robot's own occupancy map into unknown space, to within ``ε`` of the target.
+3. ``π^insp``: ``Level-0`` starts at the target (eq 7). At every view the pose is registered
+   (eq 9) with its image, part detections go to the interim Pose-Feature graph, and FLIE's local
+   view planner (002 eqs 1-2) gives the next view. A level ends when, back within
+   ``d_thresh^I`` of its start, the view matches the level's first ``N`` images (eq 8,
+   ``Γ >= Γ_thresh``); each level is then pruned (eq 10). Aerial robots climb by the vertical
+   overlap until the target's height is covered; ground robots do one level.
+4. After inspection: containment polygon, centroid refinement, Target-layer edges to inspected
+   neighbours (realised by routes through known free space), then ``π^expl:LE``, a survey
+   around the inspected target.
+5. Repeat until no uninspected target remains (then visit exploration frontiers to find more)
+   or the time budget ends.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import ndimage
+
+from seminspect.core.errors import PlanningError
+from seminspect.core.params import InspectionParams
+from seminspect.geometry.transforms import quat_from_yaw
+from seminspect.graphs.lsg.graph import LayeredSemanticGraph
+from seminspect.graphs.lsg.model import TargetNode, TargetStatus
+from seminspect.mapping.voxel import VoxelMap
+from seminspect.missions.config import MissionConfig, inspection_params, survey_headings
+from seminspect.missions.metrics import CoverageRecorder, Timers
+from seminspect.missions.navigation import Navigator, find_frontiers
+from seminspect.missions.platform import Platform, heading_to
+from seminspect.missions.rundir import RunDirectory
+from seminspect.perception.detections import detection_points, observe
+from seminspect.perception.observation import Observation
+from seminspect.perception.similarity import (
+    ORB_GAMMA_THRESHOLD,
+    ImageFeatures,
+    SceneMatcher,
+    scene_similarity,
+)
+from seminspect.planning.gridmap import CostModel
+from seminspect.planning.hierarchical import HierarchicalPlanner, RoutePlan
+from seminspect.planning.local import LocalPlanner
+from seminspect.planning.smoothing import refine_path
+from seminspect.planning.utility import UtilityTerms, select_target
+from seminspect.planning.view_planner import ViewConstraints, next_view_pose
+from seminspect.sensors import Detection, Frame
+
+#: No new target is started with less simulated time left than this [s].
+MIN_INSPECTION_S = 60.0
+#: Points this close to the ground are not part of a standing object [m].
+GROUND_CLEARANCE = 0.15
+#: Extra clearance added to the robot radius in the planners' inflation [m].
+PLANNING_MARGIN = 0.2
+#: A level also ends (as a safety cap) once the robot has circled the target this far [rad].
+LEVEL_SWEEP_CAP = 2.0 * math.pi + math.radians(40)
+#: A part belongs to the inspected target when this share of its mask lies on the target's.
+PART_OVERLAP = 0.5
+
+
+@dataclass
+class MissionProgress:
+    """A snapshot for progress displays."""
+
+    sim_time: float
+    budget: float
+    phase: str
+    detected: int
+    inspected: int
+
+
+@dataclass
+class PlanningRecord:
+    """One hierarchical planning query made during the mission."""
+
+    goal: str
+    seconds: float
+    target_layer_s: float
+    local_layers_s: float
+    length: float
+    settled: int
+
+
+@dataclass
+class _Level:
+    """Bookkeeping for the level being inspected."""
+
+    start: NDArray[np.float64]
+    candidates: list[ImageFeatures] = field(default_factory=list)
+    left_start: bool = False
+    poses: int = 0
+    sweep: float = 0.0
+    last_bearing: float | None = None
+
+
+class XFlie:
+    """One xFLIE mission on a :class:`Platform` (see the module docstring).
+
+    Args:
+        config: a resolved :class:`MissionConfig`.
+        platform: the robot.
+        occupancy: the robot's (initially unknown) occupancy map of the site's bounding box.
+        ground_z: height of the ground where the robot started (it stood on it).
+        run: where images and events go (optional).
+        progress: called after every step with a :class:`MissionProgress`.
+    """
+
+    def __init__(
+        self,
+        config: MissionConfig,
+        platform: Platform,
+        occupancy: VoxelMap,
+        *,
+        ground_z: float,
+        run: RunDirectory | None = None,
+        progress: Callable[[MissionProgress], None] | None = None,
+    ) -> None:
+        assert config.inspection is not None and config.time_budget_s is not None
+        #: Object points below this height are bled pixels on the ground, not the object.
+        self.min_height = ground_z + GROUND_CLEARANCE
+        self.config = config
+        self.params = inspection_params(config)
+        self.platform = platform
+        self.occupancy = occupancy
+        self.run = run
+        self.progress = progress
+        self.budget = config.time_budget_s
+        self.graph = LayeredSemanticGraph(self.params, robot_position=platform.position)
+        self.planner = HierarchicalPlanner(self.graph)
+        self.timers = Timers()
+        self.coverage = CoverageRecorder(config.inspection.d_view)
+        self.matcher = SceneMatcher()
+        self.gamma_thresh = (
+            ORB_GAMMA_THRESHOLD if config.gamma_thresh is None else config.gamma_thresh
+        )
+        self.view = ViewConstraints(
+            d_view=config.inspection.d_view,
+            overlap_h=config.inspection.overlap_h,
+            overlap_v=config.inspection.overlap_v,
+            hfov_deg=self.params.fov_deg,
+            vfov_deg=platform_vfov(self.params),
+        )
+        model = CostModel(config.robot.radius + PLANNING_MARGIN, risk_radius=0.3, unknown_cost=1.0)
+        band = (0.3, max(1.0, config.robot.body_height + 0.5))
+        self.local = LocalPlanner(model, config.mode or "ground", band=band)
+        self.navigator = Navigator(
+            platform,
+            occupancy,
+            self.local,
+            self._on_transit_frame,
+            lidar_every_m=config.exploration.lidar_every_m,
+            camera_every_m=config.exploration.camera_every_m,
+            clear_misses_to=self.params.d_max,
+        )
+        self.unreachable: set[str] = set()
+        self.failed_frontiers: list[NDArray[np.float64]] = []
+        self.hierarchical: list[PlanningRecord] = []
+        self.level_endings: dict[str, int] = {"similarity": 0, "cap": 0}
+        self.phase = "start"
+        self.stop_reason = ""
+        self._frame_count = 0
+
+    # ----------------------------------------------------------------- top level
+    @property
+    def time_left(self) -> float:
+        return self.budget - self.platform.time
+
+    def execute(self) -> str:
+        """Run until done or out of time; returns why it stopped."""
+        self._phase("explore-360")
+        self.navigator.sense_lidar()
+        self.survey()
+        frontier_hops = 0
+        while self.time_left > MIN_INSPECTION_S:
+            choice, terms = select_target(self.graph, exclude=self.unreachable)
+            self._log_utilities(choice, terms)
+            if choice is None:
+                if frontier_hops >= self.config.exploration.frontier_max_hops or not self.explore():
+                    self.stop_reason = "no uninspected target and no frontier left"
+                    break
+                frontier_hops += 1
+                continue
+            target = self.graph.target(choice.target_id)
+            if not self.reach(target):
+                self.unreachable.add(target.id)
+                self._event("unreachable", target=target.id)
+                continue
+            if not self.confirm(target):
+                self.graph.discard_target(target.id)
+                self._event("discarded", target=target.id, reason="not re-observed on arrival")
+                continue
+            self.inspect(target)
+            self._phase("explore-LE")
+            self.survey()
+        if not self.stop_reason:
+            self.stop_reason = "time budget spent"
+        return self.stop_reason
+
+    def _phase(self, name: str) -> None:
+        self.phase = name
+        self._report()
+
+    def _report(self) -> None:
+        if self.progress is not None:
+            targets = self.graph.targets()
+            self.progress(
+                MissionProgress(
+                    self.platform.time,
+                    self.budget,
+                    self.phase,
+                    len(targets),
+                    sum(t.inspected for t in targets),
+                )
+            )
+
+    def _event(self, kind: str, **fields: object) -> None:
+        if self.run is not None:
+            self.run.log_event(kind, self.platform.time, **fields)
+
+    # ----------------------------------------------------------------- exploration
+    def survey(self) -> None:
+        """``π^expl:360``: turn on the spot, registering every frame's detections."""
+        count = survey_headings(self.params.fov_deg, self.config.exploration.survey_overlap)
+        start = self.platform.yaw
+        for k in range(count):
+            if self.time_left <= 0:
+                return
+            self.platform.turn_to(start + k * 2.0 * math.pi / count)
+            self.register_targets(self._capture())
+        self._report()
+
+    def explore(self) -> bool:
+        """Drive to the nearest reachable frontier and survey there; False if none is left."""
+        self._phase("explore-frontier")
+        band = self.local.band or (self.platform.position[2] - 1.0, self.platform.position[2] + 1.0)
+        frontiers = find_frontiers(
+            self.occupancy,
+            band,
+            self.config.exploration.frontier_min_cells,
+            self.platform.position[2],
+        )
+        here = self.platform.position
+        frontiers = [f for f in frontiers if not self._failed_frontier(f.goal)]
+        frontiers.sort(key=lambda f: float(np.linalg.norm((f.goal - here)[:2])))
+        for frontier in frontiers[:5]:
+            with self.timers("planning"):
+                reached = self.navigator.go_to(frontier.goal, radius=1.5)
+            if reached:
+                self._event("frontier", goal=frontier.goal.round(2).tolist(), cells=frontier.cells)
+                self.survey()
+                return True
+            self.failed_frontiers.append(frontier.goal)
+        return False
+
+    def _failed_frontier(self, goal: NDArray[np.float64]) -> bool:
+        return any(np.linalg.norm((goal - f)[:2]) < 3.0 for f in self.failed_frontiers)
+
+    # ----------------------------------------------------------------- perception
+    def _capture(self) -> Frame:
+        with self.timers("sensing"):
+            frame = self.platform.capture()
+        self._frame_count += 1
+        return frame
+
+    def _on_transit_frame(self, frame: Frame) -> None:
+        self._frame_count += 1
+        self.register_targets(frame)
+
+    def _detect(self, frame: Frame, level: str, labels: Iterable[str]) -> list[Detection]:
+        """Segmentations at or above the confidence threshold."""
+        detections = self.platform.detect(frame, level, labels)
+        return [d for d in detections if d.score >= self.config.min_score]
+
+    def register_targets(self, frame: Frame) -> None:
+        """Eqs (3)-(5) for one frame: register its detections, optimise, merge."""
+        with self.timers("perception"):
+            detections = self._detect(frame, "instance", self.config.target_classes or ())
+            observations = [
+                observe(
+                    frame,
+                    d,
+                    method=self.config.localisation,
+                    erosion_px=self.config.mask_erosion_px,
+                    min_height=self.min_height,
+                    max_range=self.params.d_max,
+                )
+                for d in detections
+            ]
+        with self.timers("graph"):
+            for z in observations:
+                if z is not None:
+                    self.graph.register_target(z)
+            self.graph.update_robot(
+                frame.odometry_position, frame.odometry_orientation, frame.stamp
+            )
+            update = self.graph.optimise_targets()
+        for added in update.added:
+            self._event(
+                "detected",
+                target=added,
+                position=self.graph.target(added).position.round(2).tolist(),
+            )
+
+    # ----------------------------------------------------------------- navigation
+    def reach(self, target: TargetNode) -> bool:
+        """Navigate to within ``ε`` of a detected target (eq 2's proximity condition)."""
+        self._phase("navigate")
+        goal = target.position
+        self._event("selected", target=target.id, utility=round(target.utility, 4))
+        self._hierarchical_leg(goal)
+        for radius in (self.params.epsilon, self.params.epsilon + 1.0, self.params.epsilon + 2.5):
+            with self.timers("planning"):
+                arrived = self.navigator.go_to(goal, radius, final_yaw=None)
+            if arrived:
+                self._event("arrived", target=target.id)
+                return True
+            if self.time_left <= 0:
+                return False
+        return False
+
+    def confirm(self, target: TargetNode) -> bool:
+        """Look for the target from where the robot arrived: straight at it, then either side.
+
+        A detection that is not there when the robot comes to look (a false positive of the
+        segmentation, or a badly localised one) is discarded rather than inspected.
+        """
+        facing = heading_to(self.platform.position, target.position)
+        for offset in (0.0, math.radians(35), -math.radians(35)):
+            self.platform.turn_to(facing + offset)
+            frame = self._capture()
+            self.register_targets(frame)
+            if target.id not in self.graph:  # merged away by eq (4) after a better view
+                return False
+            _, points = self._target_view(frame, target, self.params.d_check_T)
+            if len(points):
+                self.platform.turn_to(facing)
+                return True
+        return False
+
+    def _hierarchical_leg(self, goal: NDArray[np.float64]) -> None:
+        """The known part of the route: over the 3DLSG to the traversable node nearest ``goal``."""
+        if not self.graph.targets(TargetStatus.INSPECTED) or self.config.planner != "hierarchical":
+            return
+        with self.timers("planning"):
+            entry = self.planner.nearest_entry(goal)
+            entry_position = self.graph.node(entry).position
+            here = self.platform.position
+            if np.linalg.norm((goal - entry_position)[:2]) + 5.0 >= np.linalg.norm(
+                (goal - here)[:2]
+            ):
+                return  # the graph gets the robot no closer than driving straight for it
+            plan = self.planner.plan(entry, here)
+            self.record_plan(entry, plan)
+            route = refine_path(plan.waypoints, self.navigator.segment_is_free).waypoints
+        with self.timers("driving"):
+            self.navigator.drive(route)
+
+    # ----------------------------------------------------------------- inspection
+    def inspect(self, target: TargetNode) -> None:
+        """``π^insp`` on one target, level by level, then the post-inspection updates."""
+        self._phase("inspect")
+        assert self.config.inspection is not None
+        start = self._view_pose(image=None)
+        with self.timers("graph"):
+            self.graph.begin_inspection(target.id, start)
+        heights: list[float] = []
+        for level in range(self.config.inspection.max_levels):
+            if level > 0 and not self._climb(target, heights):
+                break
+            self._inspect_level(target, heights)
+            if self.config.mode != "aerial" or self.time_left <= 0:
+                break
+        if len(LayeredSemanticGraph.entry_level(target).poses) < 3:
+            with self.timers("graph"):
+                self.graph.cancel_inspection()
+            self.unreachable.add(target.id)
+            self._event("inspection-cancelled", target=target.id, reason="too few views")
+            return
+        with self.timers("graph"):
+            self.graph.finish_inspection()
+        for pruned in self.graph.pruned:
+            self._event("discarded", target=pruned, reason=f"re-detection of {target.id}")
+        self._connect_inspected(target)
+        self._event(
+            "inspected",
+            target=target.id,
+            position=target.position.round(2).tolist(),
+            levels=len(target.levels),
+        )
+        if self.run is not None:
+            self.run.write_graph(self.graph, snapshot_time=self.platform.time)
+            self.run.flush_events()
+
+    def _view_pose(self, image: str | None) -> Observation:
+        return Observation.view_pose(
+            self.platform.position,
+            quat_from_yaw(self.platform.yaw),
+            image=image,
+            stamp=self.platform.time,
+        )
+
+    def _inspect_level(self, target: TargetNode, heights: list[float]) -> None:
+        assert self.config.inspection is not None
+        state = _Level(self.platform.position.copy())
+        surface = np.empty((0, 3))
+        while self.time_left > 0:
+            frame = self._capture()
+            mask, points = self._target_view(frame, target)
+            if len(points):
+                surface = points
+                heights.append(float(points[:, 2].max()))
+            self._register_view(target, frame, mask, points)
+            state.poses += 1
+            if self._level_complete(state, frame, target, surface):
+                break
+            if not self._step_along(surface, target):
+                break
+
+    def _target_view(
+        self, frame: Frame, target: TargetNode, gate: float | None = None
+    ) -> tuple[NDArray[np.bool_] | None, NDArray[np.float64]]:
+        """The mask and points of the target in this frame: the nearest detection of its label
+        whose points lie within ``gate`` (default ``2 d_check^T``) of the target."""
+        gate = 2.0 * self.params.d_check_T if gate is None else gate
+        with self.timers("perception"):
+            detections = self._detect(frame, "instance", [target.label])
+            best: tuple[float, Detection, NDArray[np.float64]] | None = None
+            for detection in detections:
+                points = detection_points(
+                    frame, detection, self.config.mask_erosion_px, self.min_height
+                )
+                if not len(points):
+                    continue
+                distance = float(
+                    np.linalg.norm(np.median(points, axis=0)[:2] - target.position[:2])
+                )
+                if distance <= gate and (best is None or distance < best[0]):
+                    best = (distance, detection, points)
+        if best is None:
+            return None, np.empty((0, 3))
+        return best[1].mask, best[2]
+
+    def _register_view(
+        self,
+        target: TargetNode,
+        frame: Frame,
+        mask: NDArray[np.bool_] | None,
+        points: NDArray[np.float64],
+    ) -> None:
+        """Eq (9) for the view, and its features into the interim ``G~^PF``."""
+        assert self.config.inspection is not None
+        image = None
+        if self.run is not None and self.config.inspection.save_images:
+            image = self.run.write_image(f"{target.id}-{self._frame_count:05d}", frame.intensity)
+        with self.timers("graph"):
+            self.graph.register_pose(self._view_pose(image))
+        self.coverage.add_frame(target.id, frame, points)
+        if mask is None:
+            return
+        grown = dilate(mask, 5)
+        with self.timers("perception"):
+            parts = self._detect(frame, "part", self.config.feature_labels or ())
+            features = [
+                observe(frame, p, image=image, method="median")
+                for p in parts
+                if (p.mask & grown).sum() >= PART_OVERLAP * p.area_px
+            ]
+        with self.timers("graph"):
+            for z in features:
+                if z is not None:
+                    self.graph.register_feature(z)
+
+    def _level_complete(
+        self, state: _Level, frame: Frame, target: TargetNode, surface: NDArray[np.float64]
+    ) -> bool:
+        """Eq (8) scene similarity, with a sweep and pose cap as a safety net."""
+        assert self.config.inspection is not None
+        with self.timers("perception"):
+            features = self.matcher.features(frame.intensity)
+        distance = float(np.linalg.norm(self.platform.position - state.start))
+        state.left_start |= distance > self.params.d_thresh_I
+        centre = surface.mean(axis=0) if len(surface) else target.position
+        bearing = heading_to(centre, self.platform.position)
+        if state.last_bearing is not None:
+            state.sweep += abs(math.remainder(bearing - state.last_bearing, math.tau))
+        state.last_bearing = bearing
+        if len(state.candidates) < self.params.horizon_N:
+            state.candidates.append(features)
+            return False
+        if state.left_start:
+            with self.timers("perception"):
+                gamma = scene_similarity(
+                    self.matcher, features, state.candidates, distance, self.params.d_thresh_I
+                )
+            if gamma >= self.gamma_thresh:
+                self.level_endings["similarity"] += 1
+                self._event(
+                    "level-complete",
+                    target=target.id,
+                    gamma=round(gamma, 3),
+                    poses=state.poses,
+                    reason="similarity",
+                )
+                return True
+        if (
+            state.sweep >= LEVEL_SWEEP_CAP
+            or state.poses >= self.config.inspection.max_poses_per_level
+        ):
+            self.level_endings["cap"] += 1
+            self._event("level-complete", target=target.id, poses=state.poses, reason="cap")
+            return True
+        return False
+
+    def _step_along(self, surface: NDArray[np.float64], target: TargetNode) -> bool:
+        """Move to the next view pose of 002 eqs (1)-(2); False when no step is possible."""
+        points = surface if len(surface) else target.position[None, :]
+        with self.timers("planning"):
+            try:
+                pose = next_view_pose(self.platform.position, points, self.view)
+            except PlanningError:
+                return False
+        goal = pose.position
+        if self.config.mode == "ground":
+            goal = np.array([goal[0], goal[1], self.platform.position[2]])
+        with self.timers("driving"):
+            if self.navigator.segment_is_free(self.platform.position, goal):
+                motion = self.platform.move_to(goal, pose.yaw)
+                if motion.reached:
+                    self.navigator.sense_lidar()
+                    return True
+            with self.timers("planning"):
+                arrived = self.navigator.go_to(goal, radius=0.5, final_yaw=pose.yaw, attempts=2)
+        return arrived
+
+    def _climb(self, target: TargetNode, heights: list[float]) -> bool:
+        """Start the next level one vertical step up, while the target rises above the view."""
+        top = max(heights) if heights else target.position[2]
+        reach = math.tan(math.radians(self.view.vfov_deg) / 2) * self.view.d_view
+        if self.platform.position[2] + reach >= top:
+            return False
+        goal = self.platform.position + np.array([0.0, 0.0, self.view.vertical_step])
+        with self.timers("driving"):
+            motion = self.platform.move_to(goal, self.platform.yaw)
+        if not motion.reached:
+            return False
+        with self.timers("graph"):
+            self.graph.begin_level(self._view_pose(image=None))
+        self._event("level", target=target.id, height=round(float(goal[2]), 2))
+        return True
+
+    def _connect_inspected(self, target: TargetNode) -> None:
+        """``v_I - v_I`` edges to the nearest inspected targets, through known free space."""
+        inspected = [t for t in self.graph.targets(TargetStatus.INSPECTED) if t is not target]
+        entry = LayeredSemanticGraph.entry_level(target).position
+        inspected.sort(
+            key=lambda t: float(
+                np.linalg.norm(LayeredSemanticGraph.entry_level(t).position - entry)
+            )
+        )
+        known = LocalPlanner(
+            CostModel(self.local.model.robot_radius, risk_radius=0.0, unknown_cost=None),
+            self.local.mode,
+            band=self.local.band or (0.3, 1.5),
+        )
+        for other in inspected[:3]:
+            start = LayeredSemanticGraph.entry_level(other).position
+            with self.timers("planning"):
+                try:
+                    path = known.plan(self.occupancy, start, entry)
+                except PlanningError:
+                    continue
+            via = path.waypoints[1:-1]
+            with self.timers("graph"):
+                self.graph.connect_targets(other.id, target.id, via if len(via) else None)
+
+    # ----------------------------------------------------------------- logs
+    def record_plan(self, goal: str, plan: RoutePlan) -> None:
+        """Keep a hierarchical query's timing for the Table 3 planning-time column."""
+        self.hierarchical.append(
+            PlanningRecord(
+                goal,
+                plan.timing.total_s,
+                plan.timing.target_layer_s,
+                plan.timing.local_layers_s,
+                plan.length,
+                plan.settled,
+            )
+        )
+
+    def _log_utilities(self, choice: UtilityTerms | None, terms: list[UtilityTerms]) -> None:
+        """Record every candidate's eq (6) terms at a decision (for the utility picture)."""
+        if terms:
+            self._event(
+                "utilities",
+                chosen=None if choice is None else choice.target_id,
+                terms={
+                    t.target_id: [
+                        round(t.utility, 4),
+                        round(t.proximity, 4),
+                        round(t.area, 5),
+                        round(t.centrality, 4),
+                    ]
+                    for t in terms
+                },
+            )
+
+
+def dilate(mask: NDArray[np.bool_], pixels: int) -> NDArray[np.bool_]:
+    """Grow a mask by ``pixels`` (square structuring element)."""
+    return ndimage.binary_dilation(mask, iterations=pixels)
+
+
+def platform_vfov(params: InspectionParams) -> float:
+    """Vertical field of view of a ``I_w x I_h`` camera with horizontal FOV ``α``."""
+    half = math.atan(math.tan(params.fov_rad / 2) * params.image_height / params.image_width)
+    return math.degrees(2 * half)

@@ -1,0 +1,136 @@
+"""Pictures of a run, drawn from its run directory alone (so interrupted runs get them too).
+
+* ``trajectory.png``: the robot's true and believed path over the top-down world, with the
+  targets it found (inspected ones with their containment polygons);
+* ``graph.png``: the final 3DLSG's layers stacked above the world's footprints (000 Figs 2, 12);
+* ``utility.png``: eq (6) for every candidate at every decision, the chosen one marked.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from seminspect.core.errors import FileFormatError
+from seminspect.core.io import read_versioned_json
+from seminspect.graphs.lsg.graph import LayeredSemanticGraph
+from seminspect.graphs.lsg.io import load_graph
+from seminspect.missions.rundir import CONFIG_FORMAT
+from seminspect.report.figures import new_figure, save_figure
+from seminspect.report.lsg import draw_layers
+from seminspect.report.worlds import draw_top_down
+from seminspect.worlds import World, generate_world
+
+
+def load_run_world(run_dir: Path) -> World:
+    """Regenerate the world a run used (worlds are deterministic under their seed)."""
+    config = read_versioned_json(run_dir / "config.json", CONFIG_FORMAT, [1])["config"]
+    return generate_world(config["world"], config["scenario"], seed=config["seed"])
+
+
+def load_trajectory(run_dir: Path) -> np.ndarray:
+    path = run_dir / "trajectory.csv"
+    if not path.exists():
+        return np.empty((0, 9))
+    try:
+        return np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    except ValueError as exc:
+        raise FileFormatError(f"{path}: {exc}") from None
+
+
+def load_events(run_dir: Path) -> list[dict]:
+    path = run_dir / "events.jsonl"
+    if not path.exists():
+        return []
+    return [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines() if line]
+
+
+def trajectory_figure(world: World, graph: LayeredSemanticGraph, trajectory: np.ndarray):
+    figure = new_figure(12, 8)
+    ax = figure.add_subplot()
+    draw_top_down(world, ax)
+    if len(trajectory):
+        ax.plot(
+            trajectory[:, 1], trajectory[:, 2], color="tab:blue", linewidth=1.2, label="path (true)"
+        )
+        ax.plot(
+            trajectory[:, 5],
+            trajectory[:, 6],
+            color="tab:cyan",
+            linewidth=0.8,
+            linestyle="--",
+            label="path (odometry)",
+        )
+    for target in graph.targets():
+        colour = "tab:red" if target.inspected else "tab:orange"
+        ax.plot(*target.position[:2], marker="o", color=colour, markersize=6)
+        ax.annotate(
+            target.id,
+            target.position[:2],
+            fontsize=7,
+            color=colour,
+            xytext=(4, 4),
+            textcoords="offset points",
+        )
+        if target.polygon is not None:
+            ring = np.vstack([target.polygon, target.polygon[:1]])
+            ax.plot(ring[:, 0], ring[:, 1], color=colour, linewidth=0.8)
+    ax.plot([], [], marker="o", color="tab:red", linestyle="", label="inspected target")
+    ax.plot([], [], marker="o", color="tab:orange", linestyle="", label="detected target")
+    ax.legend(loc="upper right", fontsize=8)
+    ax.set_title("Trajectory and targets")
+    return figure
+
+
+def utility_figure(events: list[dict]):
+    figure = new_figure(10, 5)
+    ax = figure.add_subplot()
+    series: dict[str, list[tuple[float, float]]] = {}
+    chosen: list[tuple[float, float]] = []
+    for event in events:
+        if event.get("event") != "utilities":
+            continue
+        for target, terms in event["terms"].items():
+            series.setdefault(target, []).append((event["t"], terms[0]))
+            if target == event.get("chosen"):
+                chosen.append((event["t"], terms[0]))
+    for target, points in sorted(series.items()):
+        data = np.array(points)
+        ax.plot(data[:, 0], data[:, 1], marker=".", linewidth=0.8, label=target)
+    if chosen:
+        data = np.array(chosen)
+        ax.scatter(
+            data[:, 0],
+            data[:, 1],
+            s=90,
+            facecolors="none",
+            edgecolors="black",
+            label="selected (argmax)",
+        )
+    ax.set_xlabel("simulated time [s]")
+    ax.set_ylabel("utility U (eq 6)")
+    ax.set_title("Target selection over time")
+    if series:
+        ax.legend(fontsize=7, ncol=2, loc="upper right")
+    return figure
+
+
+def render_run(run_dir: str | os.PathLike[str]) -> list[Path]:
+    """Draw every picture of a run into its directory; returns the files written."""
+    root = Path(run_dir)
+    world = load_run_world(root)
+    graph = load_graph(root / "graph.json")
+    footprints = [
+        np.asarray(info.footprint.exterior.coords)[:-1] for info in world.instances.values()
+    ]
+    written = [
+        save_figure(
+            trajectory_figure(world, graph, load_trajectory(root)), root / "trajectory.png"
+        ),
+        save_figure(draw_layers(graph, footprints), root / "graph.png"),
+        save_figure(utility_figure(load_events(root)), root / "utility.png"),
+    ]
+    return written
