@@ -42,6 +42,13 @@ class RobotConfig(_Strict):
         0.7, gt=0, le=5, description="camera height (ground) or take-off height (aerial) [m]"
     )
     flight_height: float = Field(2.0, gt=0, le=50, description="height of Level-0 (aerial) [m]")
+    camera_pitch_deg: float | None = Field(
+        None,
+        ge=0,
+        le=60,
+        description="camera tilt below the horizon [deg]; None: 0 (ground), 20 (aerial, to see "
+        "what lies below the flight level)",
+    )
 
 
 class InspectionConfig(_Strict):

@@ -8,6 +8,7 @@ asks the local planner for a new route when the old one now crosses an obstacle.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -21,7 +22,7 @@ from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap
 from seminspect.missions.platform import Platform
 from seminspect.planning.gridmap import CostGrid, planar_states
 from seminspect.planning.local import LocalPlanner
-from seminspect.sensors import Frame
+from seminspect.sensors import Frame, LidarScan
 
 #: Metres a goal may be missed by when the robot already stands within the goal radius plus this.
 ARRIVAL_SLACK = 0.05
@@ -69,37 +70,57 @@ class Navigator:
         self.camera_every_m = camera_every_m
         self.clear_misses_to = clear_misses_to
         self.stats = NavigationStats()
+        #: The same planner kept to observed free space, for short moves beside structures.
+        self.known_planner = LocalPlanner(
+            dataclasses.replace(planner.model, unknown_cost=None),
+            planner.mode,
+            band=planner.band or (0.0, 1.0),
+            heuristic_weight=planner.heuristic_weight,
+        )
+        self.last_scan: LidarScan | None = None
         self._since_camera = 0.0
 
     # ----------------------------------------------------------------- sensing
-    def sense_lidar(self) -> None:
-        self.occupancy.integrate_scan(self.platform.scan(), clear_misses_to=self.clear_misses_to)
+    def sense_lidar(self) -> LidarScan:
+        """Scan, update the map, and keep the scan as :attr:`last_scan`."""
+        self.last_scan = self.platform.scan()
+        self.occupancy.integrate_scan(self.last_scan, clear_misses_to=self.clear_misses_to)
+        return self.last_scan
 
-    def _grid(self) -> CostGrid:
-        return CostGrid.build(self.occupancy, self.planner.model, self.planner.band, lazy=True)
+    def _grid(self, known_only: bool = False) -> CostGrid:
+        planner = self.known_planner if known_only else self.planner
+        return CostGrid.build(self.occupancy, planner.model, planner.band, lazy=True)
 
-    def segment_is_free(self, a: ArrayLike, b: ArrayLike, grid: CostGrid | None = None) -> bool:
-        """Whether the robot's map lets it drive straight from ``a`` to ``b`` (unknown allowed)."""
-        return (grid or self._grid()).segment_is_free(a, b)
+    def segment_is_free(
+        self, a: ArrayLike, b: ArrayLike, grid: CostGrid | None = None, known_only: bool = False
+    ) -> bool:
+        """Whether the robot's map lets it drive straight from ``a`` to ``b`` (through unknown
+        space too, unless ``known_only``)."""
+        return (grid or self._grid(known_only)).segment_is_free(a, b)
 
     # ----------------------------------------------------------------- driving
-    def drive(self, waypoints: NDArray[np.float64], final_yaw: float | None = None) -> bool:
+    def drive(
+        self,
+        waypoints: NDArray[np.float64],
+        final_yaw: float | None = None,
+        known_only: bool = False,
+    ) -> bool:
         """Follow ``waypoints`` (the first is where the robot stands). False if the route became
         blocked or the robot was stopped; True when it reached the last waypoint."""
         for target in waypoints[1:]:
-            if not self._drive_segment(np.asarray(target, dtype=np.float64)):
+            if not self._drive_segment(np.asarray(target, dtype=np.float64), known_only):
                 return False
         if final_yaw is not None:
             self.platform.turn_to(final_yaw)
         return True
 
-    def _drive_segment(self, target: NDArray[np.float64]) -> bool:
+    def _drive_segment(self, target: NDArray[np.float64], known_only: bool) -> bool:
         while True:
             here = self.platform.position
             gap = float(np.linalg.norm((target - here)[:2]))
             if gap < 1e-3 and abs(target[2] - here[2]) < 1e-3:
                 return True
-            if not self._clear_ahead(here, target, gap):
+            if not self._clear_ahead(here, target, gap, known_only):
                 self.stats.replans += 1
                 return False
             step = min(gap, self.lidar_every_m) if gap > 0 else 0.0
@@ -116,11 +137,11 @@ class Navigator:
                 return False
 
     def _clear_ahead(
-        self, here: NDArray[np.float64], target: NDArray[np.float64], gap: float
+        self, here: NDArray[np.float64], target: NDArray[np.float64], gap: float, known_only: bool
     ) -> bool:
         """The segment is free, or free once past the inflation margin the robot may stand in
         (after a close view; the planner starts such routes from the nearest free cell)."""
-        grid = self._grid()
+        grid = self._grid(known_only)
         if self.segment_is_free(here, target, grid):
             return True
         escape = self.planner.model.robot_radius + self.occupancy.resolution
@@ -134,20 +155,23 @@ class Navigator:
         radius: float,
         final_yaw: float | None = None,
         attempts: int = 5,
+        known_only: bool = False,
     ) -> bool:
-        """Plan and drive to within ``radius`` of ``goal``, replanning as the map grows."""
+        """Plan and drive to within ``radius`` of ``goal``, replanning as the map grows; with
+        ``known_only`` the route stays in observed free space."""
+        planner = self.known_planner if known_only else self.planner
         goal_point = np.asarray(goal, dtype=np.float64)
         for _ in range(attempts):
             if self._arrived(goal_point, radius):
                 break
             self.stats.local_plans += 1
             try:
-                path = self.planner.plan(self.occupancy, self.platform.position, goal_point, radius)
+                path = planner.plan(self.occupancy, self.platform.position, goal_point, radius)
             except PlanningError:
                 self.stats.local_failures += 1
                 return False
             self.stats.local_planning_s.append(path.planning_time)
-            if self.drive(path.waypoints):
+            if self.drive(path.waypoints, known_only=known_only):
                 break
         arrived = self._arrived(goal_point, radius)
         if arrived and final_yaw is not None:

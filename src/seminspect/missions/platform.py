@@ -19,7 +19,7 @@ from scipy.spatial.transform import Rotation
 
 from seminspect.core.params import InspectionParams
 from seminspect.core.rng import make_rng
-from seminspect.geometry.transforms import as_point, quat_from_yaw, wrap_angle
+from seminspect.geometry.transforms import as_point, wrap_angle
 from seminspect.robot import Robot
 from seminspect.robot.robot import MoveResult
 from seminspect.sensors import CameraModel, Detection, Frame, Lidar, LidarScan, render
@@ -85,10 +85,12 @@ class SimulatedPlatform:
         speed: float,
         yaw_rate: float,
         body_height: float,
+        camera_pitch: float = 0.0,
         settle_s: float = 0.2,
         capture_s: float = 0.1,
     ) -> None:
         self.world = world
+        self.camera_pitch = camera_pitch
         self.noise = noise
         self.settle_s = settle_s
         self.capture_s = capture_s
@@ -161,15 +163,19 @@ class SimulatedPlatform:
             self.world,
             self.camera,
             late.position,
-            quat_from_yaw(late.yaw),
+            self._camera_quaternion(late.yaw),
             noise=self.noise,
             rng=self._camera_rng,
             stamp=now.time,
-            odometry=(now.odometry_position, now.odometry_quaternion),
+            odometry=(now.odometry_position, self._camera_quaternion(now.odometry_yaw)),
         )
         self.robot.wait(self.capture_s)
         self.frames += 1
         return frame
+
+    def _camera_quaternion(self, yaw: float) -> NDArray[np.float64]:
+        """The camera looks along the heading, tilted down by ``camera_pitch``."""
+        return Rotation.from_euler("ZY", [yaw, self.camera_pitch]).as_quat()
 
     def detect(self, frame: Frame, level: str, labels: Iterable[str]) -> list[Detection]:
         """Segment objects (``level="instance"``, by class) or parts (``"part"``, by part name)."""

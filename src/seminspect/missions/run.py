@@ -20,7 +20,12 @@ import numpy as np
 from seminspect.core.errors import SeminspectError
 from seminspect.mapping.voxel import VoxelMap
 from seminspect.missions.config import MissionConfig, inspection_params, resolve
-from seminspect.missions.evaluation import TargetScore, TruthTarget, score_targets
+from seminspect.missions.evaluation import (
+    DEFAULT_GATE_M,
+    TargetScore,
+    TruthTarget,
+    score_targets,
+)
 from seminspect.missions.metrics import CpuMeter
 from seminspect.missions.platform import SimulatedPlatform, mission_noise
 from seminspect.missions.report import summary_markdown
@@ -68,6 +73,9 @@ def build_mission(
     """The world, the robot in it and the executive, ready to run."""
     world = generate_world(config.world, config.scenario, seed=config.seed)
     params = inspection_params(config)
+    # Ground robots carry the camera at body height; aerial ones start at Level-0's height.
+    aerial = config.mode == "aerial"
+    start_height = config.robot.flight_height if aerial else config.robot.body_height
     platform = SimulatedPlatform(
         world,
         params,
@@ -77,14 +85,20 @@ def build_mission(
         radius=config.robot.radius,
         speed=config.robot.speed,
         yaw_rate=config.robot.yaw_rate,
-        body_height=config.robot.body_height,
+        body_height=start_height,
+        camera_pitch=math.radians(camera_pitch(config)),
     )
-    ground_z = float(platform.position[2] - config.robot.body_height)
-    if config.mode == "aerial":  # take off to the height of Level-0
-        platform.move_to([*platform.position[:2], ground_z + config.robot.flight_height])
+    ground_z = float(platform.position[2] - start_height)
     occupancy = VoxelMap.covering(world, config.map_resolution)
     mission = XFlie(config, platform, occupancy, ground_z=ground_z, run=run, progress=progress)
     return mission, world
+
+
+def camera_pitch(config: MissionConfig) -> float:
+    """Camera tilt in degrees: the configured one, or 20 for aerial and 0 for ground robots."""
+    if config.robot.camera_pitch_deg is not None:
+        return config.robot.camera_pitch_deg
+    return 20.0 if config.mode == "aerial" else 0.0
 
 
 def run_mission(
@@ -179,7 +193,9 @@ def mission_metrics(
     """Every figure of a run: 000 Table 3 and Table 6 columns, and the mission's own."""
     config = mission.config
     truths = truth_targets(world, config.target_classes or ())
-    score = score_targets(mission.graph.targets(), truths)
+    # The graph merges detections within d_check^T; score on the same terms (8 m for buildings).
+    gate = max(DEFAULT_GATE_M, mission.params.d_check_T)
+    score = score_targets(mission.graph.targets(), truths, gate=gate)
     stats = mission.graph.population()
     planning = [r.seconds for r in mission.hierarchical]
     local = mission.navigator.stats.local_planning_s

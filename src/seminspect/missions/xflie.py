@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage
+from scipy.spatial import cKDTree
 
 from seminspect.core.errors import PlanningError
 from seminspect.core.params import InspectionParams
@@ -57,6 +58,12 @@ from seminspect.planning.utility import UtilityTerms, select_target
 from seminspect.planning.view_planner import ViewConstraints, next_view_pose
 from seminspect.sensors import Detection, Frame
 
+#: Voxel size of the cloud kept of the target under inspection [m].
+TARGET_VOXEL = 0.2
+#: LiDAR returns closer than this to the target's cloud belong to it or stand beside it [m].
+ATTACHED = 1.5
+#: Fractions of the full view-planner step tried, in order, when a step is blocked.
+STEP_SCALES = (1.0, 0.5, 0.25)
 #: No new target is started with less simulated time left than this [s].
 MIN_INSPECTION_S = 60.0
 #: Points this close to the ground are not part of a standing object [m].
@@ -127,6 +134,8 @@ class XFlie:
         progress: Callable[[MissionProgress], None] | None = None,
     ) -> None:
         assert config.inspection is not None and config.time_budget_s is not None
+        #: Camera tilt below the horizon [rad] (the platform's, when it reports one).
+        self.camera_pitch = float(getattr(platform, "camera_pitch", 0.0))
         #: Object points below this height are bled pixels on the ground, not the object.
         self.min_height = ground_z + GROUND_CLEARANCE
         self.config = config
@@ -163,6 +172,7 @@ class XFlie:
             camera_every_m=config.exploration.camera_every_m,
             clear_misses_to=self.params.d_max,
         )
+        self.target_cloud = PointSet(TARGET_VOXEL)
         self.unreachable: set[str] = set()
         self.failed_frontiers: list[NDArray[np.float64]] = []
         self.hierarchical: list[PlanningRecord] = []
@@ -372,6 +382,8 @@ class XFlie:
         self._phase("inspect")
         assert self.config.inspection is not None
         start = self._view_pose(image=None)
+        self.target_cloud = PointSet(TARGET_VOXEL)
+        self._closed_levels: list[bool] = []
         with self.timers("graph"):
             self.graph.begin_inspection(target.id, start)
         heights: list[float] = []
@@ -387,8 +399,9 @@ class XFlie:
             self.unreachable.add(target.id)
             self._event("inspection-cancelled", target=target.id, reason="too few views")
             return
+        closed = [i for i, done in enumerate(self._closed_levels) if done]
         with self.timers("graph"):
-            self.graph.finish_inspection()
+            self.graph.finish_inspection(polygon_level=closed[0] if closed else 0)
         for pruned in self.graph.pruned:
             self._event("discarded", target=pruned, reason=f"re-detection of {target.id}")
         self._connect_inspected(target)
@@ -418,14 +431,30 @@ class XFlie:
             frame = self._capture()
             mask, points = self._target_view(frame, target)
             if len(points):
-                surface = points
                 heights.append(float(points[:, 2].max()))
+                self.target_cloud.add(points)
+            visible = self._surface(points)
+            if len(visible):  # out of sight for a moment (a corner): keep the last surface
+                surface = visible
             self._register_view(target, frame, mask, points)
             state.poses += 1
             if self._level_complete(state, frame, target, surface):
-                break
+                self._closed_levels.append(True)
+                return
             if not self._step_along(surface, target):
                 break
+        self._closed_levels.append(False)
+
+    def _surface(self, mask_points: NDArray[np.float64]) -> NDArray[np.float64]:
+        """What the view planner steps along: the target's points in view, and every LiDAR
+        return attached to the target (within ``ATTACHED`` of anything seen of it), so that
+        parts of it out of the camera's view and debris beside it are kept at a distance too."""
+        scan = self.navigator.last_scan
+        if scan is None or not self.target_cloud.size:
+            return mask_points
+        returns = scan.points[scan.points[:, 2] >= self.min_height]
+        attached = returns[self.target_cloud.near(returns, ATTACHED)]
+        return np.vstack([mask_points, attached]) if len(mask_points) else attached
 
     def _target_view(
         self, frame: Frame, target: TargetNode, gate: float | None = None
@@ -490,7 +519,8 @@ class XFlie:
             features = self.matcher.features(frame.intensity)
         distance = float(np.linalg.norm(self.platform.position - state.start))
         state.left_start |= distance > self.params.d_thresh_I
-        centre = surface.mean(axis=0) if len(surface) else target.position
+        seen = self.target_cloud.points
+        centre = seen.mean(axis=0) if len(seen) else target.position
         bearing = heading_to(centre, self.platform.position)
         if state.last_bearing is not None:
             state.sweep += abs(math.remainder(bearing - state.last_bearing, math.tau))
@@ -523,30 +553,52 @@ class XFlie:
         return False
 
     def _step_along(self, surface: NDArray[np.float64], target: TargetNode) -> bool:
-        """Move to the next view pose of 002 eqs (1)-(2); False when no step is possible."""
-        points = surface if len(surface) else target.position[None, :]
-        with self.timers("planning"):
-            try:
-                pose = next_view_pose(self.platform.position, points, self.view)
-            except PlanningError:
-                return False
-        goal = pose.position
+        """Move to the next view pose of 002 eqs (1)-(2); False when no step is possible.
+
+        When the full step is blocked, shorter steps along the surface are tried before giving
+        up.
+        """
+        points = self._surface_in_view(surface) if len(surface) else target.position[None, :]
+        for scale in STEP_SCALES:
+            view = self.view.model_copy(
+                update={"overlap_h": 1.0 - (1.0 - self.view.overlap_h) * scale}
+            )
+            with self.timers("planning"):
+                try:
+                    pose = next_view_pose(self.platform.position, points, view)
+                except PlanningError:
+                    return False
+            if self._move_to_view(pose.position, pose.yaw):
+                return True
+        return False
+
+    def _surface_in_view(self, surface: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The surface up to the top of the view: parts above it do not limit the level, while
+        anything below the robot (a collapsed slab, rubble) must keep its distance too."""
+        reach = math.tan(math.radians(self.view.vfov_deg) / 2) * self.view.d_view
+        below = surface[surface[:, 2] <= self.platform.position[2] + reach]
+        return below if len(below) else surface
+
+    def _move_to_view(self, goal: NDArray[np.float64], yaw: float) -> bool:
+        """A short move beside the structure, through space the robot has seen to be free."""
         if self.config.mode == "ground":
             goal = np.array([goal[0], goal[1], self.platform.position[2]])
         with self.timers("driving"):
-            if self.navigator.segment_is_free(self.platform.position, goal):
-                motion = self.platform.move_to(goal, pose.yaw)
+            if self.navigator.segment_is_free(self.platform.position, goal, known_only=True):
+                motion = self.platform.move_to(goal, yaw)
+                self.navigator.sense_lidar()
                 if motion.reached:
-                    self.navigator.sense_lidar()
                     return True
             with self.timers("planning"):
-                arrived = self.navigator.go_to(goal, radius=0.5, final_yaw=pose.yaw, attempts=2)
-        return arrived
+                return self.navigator.go_to(
+                    goal, radius=0.5, final_yaw=yaw, attempts=2, known_only=True
+                )
 
     def _climb(self, target: TargetNode, heights: list[float]) -> bool:
         """Start the next level one vertical step up, while the target rises above the view."""
         top = max(heights) if heights else target.position[2]
-        reach = math.tan(math.radians(self.view.vfov_deg) / 2) * self.view.d_view
+        half = math.radians(self.view.vfov_deg) / 2
+        reach = self.view.d_view * math.tan(half - self.camera_pitch)
         if self.platform.position[2] + reach >= top:
             return False
         goal = self.platform.position + np.array([0.0, 0.0, self.view.vertical_step])
@@ -614,6 +666,34 @@ class XFlie:
                     for t in terms
                 },
             )
+
+
+class PointSet:
+    """Points thinned to one per voxel, with radius queries."""
+
+    def __init__(self, voxel: float) -> None:
+        self.voxel = voxel
+        self.points = np.empty((0, 3))
+        self._tree: cKDTree | None = None
+
+    @property
+    def size(self) -> int:
+        return len(self.points)
+
+    def add(self, points: NDArray[np.float64]) -> None:
+        merged = np.vstack([self.points, points])
+        _, first = np.unique(
+            np.floor(merged / self.voxel).astype(np.int64), axis=0, return_index=True
+        )
+        self.points = merged[np.sort(first)]
+        self._tree = None
+
+    def near(self, points: NDArray[np.float64], radius: float) -> NDArray[np.bool_]:
+        """Which ``points`` lie within ``radius`` of the set."""
+        if self._tree is None:
+            self._tree = cKDTree(self.points)
+        distance, _ = self._tree.query(points, distance_upper_bound=radius)
+        return np.isfinite(distance)
 
 
 def dilate(mask: NDArray[np.bool_], pixels: int) -> NDArray[np.bool_]:

@@ -15,6 +15,9 @@ from seminspect.perception.localisation import Method, erode_mask, localise_poin
 from seminspect.perception.observation import Observation
 from seminspect.sensors import Detection, Frame
 
+#: Masks larger than this are sampled on a regular pixel grid before back-projection.
+MAX_MASK_POINTS = 20_000
+
 
 def detection_points(
     frame: Frame, detection: Detection, erosion_px: int = 0, min_height: float | None = None
@@ -23,9 +26,16 @@ def detection_points(
 
     ``erosion_px`` shrinks the mask first (against masks that bleed onto the background);
     ``min_height`` drops points below that height, i.e. bled pixels on the ground around an
-    object that stands on it.
+    object that stands on it. A mask larger than ``MAX_MASK_POINTS`` pixels (a building that
+    fills the image) is sampled on a regular pixel grid first.
     """
-    points = frame.points(erode_mask(detection.mask, erosion_px), use_odometry=True)
+    mask = erode_mask(detection.mask, erosion_px)
+    step = math.ceil(math.sqrt(detection.area_px / MAX_MASK_POINTS))
+    if step > 1:
+        grid = np.zeros_like(mask)
+        grid[::step, ::step] = True
+        mask = mask & grid
+    points = frame.points(mask, use_odometry=True)
     return points if min_height is None else points[points[:, 2] >= min_height]
 
 

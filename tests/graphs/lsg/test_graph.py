@@ -203,3 +203,19 @@ def test_an_inspection_too_short_for_a_polygon_is_cancelled() -> None:
     for x, y in RING:
         graph.register_pose(Observation.view_pose([x, y, 0.7]))
     assert graph.abort_inspection() is car and car.inspected
+
+
+def test_the_polygon_can_come_from_a_later_level() -> None:
+    graph = LayeredSemanticGraph()
+    graph.register_target(Observation([10, 0, 3], label="building", score=1, mask_area=1))
+    graph.optimise_targets()
+    graph.begin_inspection("building-0", Observation.view_pose([6, 0, 2]))
+    for x, y in ((6, -2), (8, -4)):  # Level-0 broke off after two views
+        graph.register_pose(Observation.view_pose([x, y, 2]))
+    graph.begin_level(Observation.view_pose([6, 0, 5]))
+    for x, y in RING:
+        graph.register_pose(Observation.view_pose([x, y, 5]))
+    with pytest.raises(InvalidInputError, match="no level 2"):
+        graph.finish_inspection(polygon_level=2)
+    building = graph.finish_inspection(polygon_level=1)
+    np.testing.assert_allclose(building.position, [10.0, 0.0, 3.0])

@@ -495,10 +495,11 @@ class LayeredSemanticGraph:
         self._connect(pose.feature_graph, pose, feature, EdgeKind.SYMBOLIC)
         return feature
 
-    def finish_inspection(self) -> TargetNode:
+    def finish_inspection(self, polygon_level: int = 0) -> TargetNode:
         """Close the last level, build the containment polygon and mark the target inspected.
 
-        The polygon's vertices are the pose nodes of the first level (000 Sec V-B); the target's
+        The polygon's vertices are the pose nodes of the first level (000 Sec V-B), or of level
+        ``polygon_level`` when the caller knows the first level's ring did not close; the target's
         position moves to the polygon's centroid (height unchanged). With fewer than three
         distinct poses there is no polygon and the position is left as detected. Detected
         targets that the polygon now contains, or that lie within ``d_check^T`` of the refined
@@ -508,8 +509,10 @@ class LayeredSemanticGraph:
         inspection = self._require_inspection()
         self.close_level()
         target = inspection.target
-        first_level = self.entry_level(target)
-        polygon = ring_polygon([p.position[:2] for p in first_level.poses])
+        levels = target.levels
+        if not 0 <= polygon_level < len(levels):
+            raise InvalidInputError(f"{target.id} has no level {polygon_level}")
+        polygon = ring_polygon([p.position[:2] for p in levels[polygon_level].poses])
         if polygon is not None:
             target.polygon = polygon
             centre = polygon_centroid(polygon)
