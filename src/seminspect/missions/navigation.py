@@ -87,6 +87,14 @@ class Navigator:
         self.occupancy.integrate_scan(self.last_scan, clear_misses_to=self.clear_misses_to)
         return self.last_scan
 
+    def mark_contact(self, contact: NDArray[np.float64] | None) -> None:
+        """Write a felt obstacle into the map, so that no route tries it again."""
+        if contact is None:
+            return
+        cell = self.occupancy.world_to_index(contact)
+        if self.occupancy.contains_index(cell):
+            self.occupancy.states[tuple(cell)] = OCCUPIED
+
     def _grid(self, known_only: bool = False) -> CostGrid:
         planner = self.known_planner if known_only else self.planner
         return CostGrid.build(self.occupancy, planner.model, planner.band, lazy=True)
@@ -134,6 +142,7 @@ class Navigator:
                 self.on_frame(self.platform.capture())
             if motion.blocked:
                 self.stats.blocked += 1
+                self.mark_contact(motion.contact)
                 return False
 
     def _clear_ahead(

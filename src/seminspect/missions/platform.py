@@ -30,11 +30,16 @@ from seminspect.worlds import World
 
 @dataclass(frozen=True)
 class Motion:
-    """Outcome of a motion command, in the robot's frame."""
+    """Outcome of a motion command, in the robot's frame.
+
+    ``contact`` is where the robot's body touched an obstacle when it was stopped: what a
+    bumper, or a legged robot's own obstacle avoidance, reports.
+    """
 
     reached: bool
     blocked: bool
     distance: float
+    contact: NDArray[np.float64] | None = None
 
 
 class Platform(Protocol):
@@ -145,10 +150,22 @@ class SimulatedPlatform:
         true_yaw = (
             None if yaw is None else wrap_angle(yaw + self.robot.yaw - self.robot.odometry_yaw)
         )
-        result: MoveResult = self.robot.move_to(self._to_true(goal), true_yaw)
+        target = self._to_true(goal)
+        result: MoveResult = self.robot.move_to(target, true_yaw)
+        contact = None
         if result.blocked:
             self.blocked_moves += 1
-        return Motion(result.reached, result.blocked, result.distance)
+            heading = target - result.position
+            length = float(np.linalg.norm(heading))
+            if length > 1e-9:  # the obstacle lies one body radius ahead of where it stopped
+                touch = result.position + heading / length * self.robot.radius
+                contact = self._to_odometry(touch)
+        return Motion(result.reached, result.blocked, result.distance, contact)
+
+    def _to_odometry(self, point: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The inverse of :meth:`_to_true`: a true point in the robot's odometry frame."""
+        rotate = Rotation.from_euler("z", self.robot.odometry_yaw - self.robot.yaw)
+        return rotate.apply(point - self.robot.position) + self.robot.odometry_position
 
     def turn_to(self, yaw: float) -> Motion:
         return self.move_to(self.position, yaw)

@@ -64,6 +64,10 @@ TARGET_VOXEL = 0.2
 ATTACHED = 1.5
 #: Fractions of the full view-planner step tried, in order, when a step is blocked.
 STEP_SCALES = (1.0, 0.5, 0.25)
+#: Every DEPTH_STRIDE-th pixel (rows and columns) of a depth frame goes into the map.
+DEPTH_STRIDE = 8
+#: A view move shorter than this does not count as a step along the surface [m].
+MIN_VIEW_STEP = 0.1
 #: No new target is started with less simulated time left than this [s].
 MIN_INSPECTION_S = 60.0
 #: Points this close to the ground are not part of a standing object [m].
@@ -280,10 +284,13 @@ class XFlie:
     def _capture(self) -> Frame:
         with self.timers("sensing"):
             frame = self.platform.capture()
+            self.occupancy.integrate_frame(frame, stride=DEPTH_STRIDE, use_odometry=True)
         self._frame_count += 1
         return frame
 
     def _on_transit_frame(self, frame: Frame) -> None:
+        with self.timers("sensing"):
+            self.occupancy.integrate_frame(frame, stride=DEPTH_STRIDE, use_odometry=True)
         self._frame_count += 1
         self.register_targets(frame)
 
@@ -580,18 +587,28 @@ class XFlie:
         return below if len(below) else surface
 
     def _move_to_view(self, goal: NDArray[np.float64], yaw: float) -> bool:
-        """A short move beside the structure, through space the robot has seen to be free."""
+        """A short move beside the structure. Aerial robots keep to space they have seen to be
+        free: below and beside a flying robot lies what its sensors see least."""
+        known_only = self.config.mode == "aerial"
         if self.config.mode == "ground":
             goal = np.array([goal[0], goal[1], self.platform.position[2]])
+        step = float(np.linalg.norm(goal - self.platform.position))
+        if step < MIN_VIEW_STEP:
+            return False
         with self.timers("driving"):
-            if self.navigator.segment_is_free(self.platform.position, goal, known_only=True):
+            if self.navigator.segment_is_free(self.platform.position, goal, known_only=known_only):
                 motion = self.platform.move_to(goal, yaw)
+                self.navigator.mark_contact(motion.contact)
                 self.navigator.sense_lidar()
                 if motion.reached:
                     return True
             with self.timers("planning"):
                 return self.navigator.go_to(
-                    goal, radius=0.5, final_yaw=yaw, attempts=2, known_only=True
+                    goal,
+                    radius=min(0.5, 0.25 * step),
+                    final_yaw=yaw,
+                    attempts=2,
+                    known_only=known_only,
                 )
 
     def _climb(self, target: TargetNode, heights: list[float]) -> bool:
