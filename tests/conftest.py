@@ -1,4 +1,4 @@
-"""Shared fixtures."""
+"""Shared fixtures, among them a small mission run once per session (campus, three cars)."""
 
 from __future__ import annotations
 
@@ -6,6 +6,9 @@ import os
 from pathlib import Path
 
 import pytest
+
+from seminspect.missions.config import make_config
+from seminspect.missions.run import MissionResult, run_mission
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -89,3 +92,28 @@ def labelled_scene():
         part_labels.append(np.full(500, 4))
     names = {0: "sidewalk", 1: "grass", 2: "road", 3: "car", 4: "tree"}
     return np.vstack(parts), np.concatenate(part_labels), names
+
+
+#: 000 Table 5 style queries, and one naming a part a ground robot cannot see (a hood's top).
+QUERIES = [
+    "Visit car-0",
+    "Observe front-bumper-1 in Level-0 of car-1",
+    "Visit hood-1 in Level-0 of car-2",
+]
+
+
+@pytest.fixture(scope="session")
+def mission_queries() -> list[str]:
+    return list(QUERIES)
+
+
+@pytest.fixture(scope="session")
+def small_mission(tmp_path_factory: pytest.TempPathFactory) -> MissionResult:
+    out = tmp_path_factory.mktemp("mission") / "campus-small"
+    config = make_config({"world": "campus", "scenario": "small", "seed": 0})
+    return run_mission(config, out, queries=QUERIES)
+
+
+@pytest.fixture(scope="session")
+def small_mission_dir(small_mission: MissionResult) -> Path:
+    return small_mission.run_dir

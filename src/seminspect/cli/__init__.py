@@ -20,6 +20,9 @@ from seminspect.cli._common import err_console
 from seminspect.core.config import describe_validation_error
 from seminspect.core.errors import SeminspectError
 
+#: Typer ships its own click; take its usage-error class from a public exception's ancestry.
+_USAGE_ERROR = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "UsageError")
+
 #: (module under seminspect.cli, group name, one-line help)
 #: Group modules import heavy dependencies inside their commands so ``--help`` stays fast.
 GROUPS: tuple[tuple[str, str, str], ...] = (
@@ -77,7 +80,22 @@ def main(argv: Sequence[str] | None = None) -> None:
     args = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in args or os.environ.get("SEMINSPECT_DEBUG") == "1"
     try:
-        app(args=args, prog_name="seminspect", standalone_mode=True)
+        app(args=args, prog_name="seminspect", standalone_mode=False)
+    except typer.Exit as done:
+        raise SystemExit(done.exit_code) from None
+    except _USAGE_ERROR as exc:
+        if type(exc).__name__ == "NoArgsIsHelpError":  # the help was printed
+            raise SystemExit(0) from None
+        command = exc.ctx.command_path if exc.ctx else "seminspect"
+        err_console.print(
+            f"[bold red]error:[/] {exc.format_message()} (see '{command} --help')",
+            highlight=False,
+            soft_wrap=True,
+        )
+        raise SystemExit(2) from None
+    except typer.Abort:
+        err_console.print("interrupted", highlight=False)
+        raise SystemExit(130) from None
     except (SeminspectError, ValidationError) as exc:
         if debug:
             raise

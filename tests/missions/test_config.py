@@ -1,0 +1,57 @@
+import pytest
+
+from seminspect.core.errors import InvalidInputError
+from seminspect.missions.config import (
+    CITY_BUDGETS,
+    MissionConfig,
+    inspection_params,
+    make_config,
+    resolve,
+    survey_headings,
+)
+
+
+def test_worlds_bring_their_papers_presets() -> None:
+    city = resolve(MissionConfig())
+    assert (city.world, city.scenario, city.preset, city.mode) == (
+        "city",
+        "medium",
+        "urban-simulated",
+        "ground",
+    )
+    assert city.time_budget_s == CITY_BUDGETS["medium"] == 1400.0  # 000 Sec VII-D
+    assert city.target_classes == ("car", "truck")
+    collapsed = resolve(MissionConfig(world="collapsed-buildings", scenario="industrial"))
+    assert (collapsed.preset, collapsed.mode, collapsed.target_classes) == (
+        "collapsed-buildings",
+        "aerial",
+        ("building",),
+    )
+    assert inspection_params(collapsed).d_check_T == 8.0  # 000 Table 2
+    assert resolve(MissionConfig(scenario="large")).time_budget_s == 2800.0
+
+
+def test_explicit_settings_win_over_defaults() -> None:
+    config = resolve(make_config({"world": "city", "mode": "aerial", "time_budget_s": 90}))
+    assert (config.mode, config.time_budget_s) == ("aerial", 90)
+
+
+@pytest.mark.parametrize(
+    ("values", "message"),
+    [
+        ({"seed": -1}, "seed"),
+        ({"preset": "urban"}, "preset"),
+        ({"mode": "swimming"}, "mode"),
+        ({"time_budget_s": 0}, "time_budget_s"),
+        ({"robot": {"radius": -1}}, "robot.radius"),
+        ({"warp_drive": True}, "warp_drive"),
+    ],
+)
+def test_impossible_settings_give_one_line(values, message) -> None:
+    with pytest.raises(InvalidInputError, match=message):
+        make_config(values)
+
+
+def test_survey_covers_the_full_circle() -> None:
+    assert survey_headings(69.4, 0.1) == 6  # 6 x 62.5 deg >= 360 deg
+    assert survey_headings(86.0, 0.1) == 5

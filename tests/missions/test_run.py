@@ -1,0 +1,116 @@
+"""End to end: a small mission, its run directory, interruption and failure."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from seminspect.core.errors import SeminspectError
+from seminspect.core.io import read_versioned_json
+from seminspect.graphs.lsg.io import load_graph
+from seminspect.missions.config import make_config
+from seminspect.missions.run import run_mission
+from seminspect.missions.xflie import XFlie
+from seminspect.planning.hierarchical import HierarchicalPlanner
+
+
+def test_the_small_mission_finds_inspects_and_localises_every_car(small_mission) -> None:
+    metrics = small_mission.metrics
+    assert small_mission.state == "completed"
+    assert metrics["table3"]["detected_pct"] == 100.0
+    assert metrics["table3"]["inspected_pct"] == 100.0
+    assert metrics["targets"]["false_targets"] == 0
+    assert metrics["table6"]["localisation_rmse_m"] < 0.25  # 000 Table 6: 0.17-0.24 m
+    assert metrics["mission"]["collisions"] == 0
+    assert metrics["mission"]["level_endings"]["similarity"] >= 2  # eq (8) closes levels
+
+
+def test_every_layer_is_populated_as_in_table_3(small_mission) -> None:
+    t3 = small_mission.metrics["table3"]
+    for layer in ("target", "level", "pose", "feature"):
+        assert t3[layer][0] > 0 and t3[layer][1] > 0, layer
+    assert t3["pose"][0] >= 3 * 15  # a ring of views around each of the three cars
+    assert 15 < t3["reconciled_pct"] < 40
+    graph = small_mission.mission.graph
+    for target in graph.targets():
+        assert target.polygon is not None and len(target.levels) == 1
+        assert len({f.label for p in target.levels[0].poses for f in p.features}) >= 8
+
+
+def test_the_run_directory_is_complete_and_readable(small_mission_dir: Path) -> None:
+    for name in (
+        "config.json",
+        "graph.json",
+        "metrics.json",
+        "summary.md",
+        "status.json",
+        "trajectory.csv",
+        "events.jsonl",
+    ):
+        assert (small_mission_dir / name).stat().st_size > 0, name
+    status = read_versioned_json(small_mission_dir / "status.json", "seminspect.run-status", [1])
+    assert status["state"] == "completed"
+    graph = load_graph(small_mission_dir / "graph.json")
+    pose = graph.targets()[0].levels[0].poses[0]
+    assert (small_mission_dir / pose.image).exists()  # images are referenced by path
+    assert list((small_mission_dir / "snapshots").glob("graph-*.json"))
+    events = [
+        json.loads(line) for line in (small_mission_dir / "events.jsonl").read_text().splitlines()
+    ]
+    kinds = {e["event"] for e in events}
+    assert {"detected", "selected", "arrived", "inspected", "level-complete", "utilities"} <= kinds
+    trajectory = np.loadtxt(small_mission_dir / "trajectory.csv", delimiter=",", skiprows=1)
+    assert trajectory.shape[1] == 9 and np.all(np.diff(trajectory[:, 0]) >= 0)
+
+
+def test_operator_queries_are_answered_and_driven(small_mission) -> None:
+    answers = {a.query: a for a in small_mission.answers}
+    visit = answers["Visit car-0"]
+    assert visit.reached and visit.path_length_m > 0 and visit.planning_time_s < 0.01
+    observe = answers["Observe front-bumper-1 in Level-0 of car-1"]
+    assert observe.goal == "car-1/Level-0/front-bumper-1" and observe.reached
+    unseen = answers["Visit hood-1 in Level-0 of car-2"]
+    assert not unseen.reached and "unknown feature 'hood-1'" in unseen.error
+    plan = HierarchicalPlanner(small_mission.mission.graph).query("Visit car-2")
+    assert plan.target_route[-1] == "car-2"
+
+
+def test_the_same_seed_gives_the_same_mission(small_mission, mission_queries, tmp_path) -> None:
+    config = make_config({"world": "campus", "scenario": "small", "seed": 0})
+    again = run_mission(config, tmp_path / "again", queries=mission_queries)
+    first = (small_mission.run_dir / "graph.json").read_text()
+    assert (again.run_dir / "graph.json").read_text() == first
+    assert again.metrics["mission"]["sim_time_s"] == small_mission.metrics["mission"]["sim_time_s"]
+
+
+def test_an_interrupted_run_leaves_a_valid_run_directory(tmp_path: Path) -> None:
+    calls = {"n": 0}
+
+    def interrupt_midway(progress) -> None:
+        calls["n"] += 1
+        if progress.phase == "inspect" and progress.inspected >= 1:
+            raise KeyboardInterrupt
+
+    config = make_config({"world": "campus", "scenario": "small", "seed": 1})
+    result = run_mission(config, tmp_path / "run", progress=interrupt_midway)
+    assert result.state == "interrupted" and "Ctrl-C" in result.reason
+    status = read_versioned_json(tmp_path / "run" / "status.json", "seminspect.run-status", [1])
+    assert status["state"] == "interrupted"
+    graph = load_graph(tmp_path / "run" / "graph.json")
+    assert graph.population().targets_inspected >= 1
+    assert (tmp_path / "run" / "metrics.json").exists()
+    assert not list((tmp_path / "run").glob(".*.tmp"))  # no half-written file left behind
+
+
+def test_a_failure_mid_mission_is_recorded_and_reported(tmp_path: Path, monkeypatch) -> None:
+    def broken(self, target) -> None:
+        raise RuntimeError("camera unplugged")
+
+    monkeypatch.setattr(XFlie, "inspect", broken)
+    config = make_config({"world": "campus", "scenario": "small", "seed": 0})
+    with pytest.raises(SeminspectError, match="camera unplugged"):
+        run_mission(config, tmp_path / "run")
+    status = read_versioned_json(tmp_path / "run" / "status.json", "seminspect.run-status", [1])
+    assert status["state"] == "failed" and "camera unplugged" in status["reason"]
+    assert load_graph(tmp_path / "run" / "graph.json").targets()  # what was found survives
