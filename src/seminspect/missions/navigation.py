@@ -19,6 +19,7 @@ from scipy import ndimage
 
 from seminspect.core.errors import PlanningError
 from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap
+from seminspect.missions.metrics import Timers
 from seminspect.missions.platform import Platform
 from seminspect.planning.gridmap import CostGrid, planar_states
 from seminspect.planning.local import LocalPlanner
@@ -49,6 +50,7 @@ class Navigator:
         on_frame: called with every camera frame taken while driving.
         lidar_every_m, camera_every_m: sensing intervals while driving.
         clear_misses_to: free space is cleared along LiDAR beams with no return up to this range.
+        timers: where sensing, planning and driving time is charged.
     """
 
     def __init__(
@@ -61,7 +63,9 @@ class Navigator:
         lidar_every_m: float,
         camera_every_m: float,
         clear_misses_to: float,
+        timers: Timers | None = None,
     ) -> None:
+        self.timers = timers or Timers()
         self.platform = platform
         self.occupancy = occupancy
         self.planner = planner
@@ -83,8 +87,9 @@ class Navigator:
     # ----------------------------------------------------------------- sensing
     def sense_lidar(self) -> LidarScan:
         """Scan, update the map, and keep the scan as :attr:`last_scan`."""
-        self.last_scan = self.platform.scan()
-        self.occupancy.integrate_scan(self.last_scan, clear_misses_to=self.clear_misses_to)
+        with self.timers("sensing"):
+            self.last_scan = self.platform.scan()
+            self.occupancy.integrate_scan(self.last_scan, clear_misses_to=self.clear_misses_to)
         return self.last_scan
 
     def mark_contact(self, contact: NDArray[np.float64] | None) -> None:
@@ -104,7 +109,8 @@ class Navigator:
     ) -> bool:
         """Whether the robot's map lets it drive straight from ``a`` to ``b`` (through unknown
         space too, unless ``known_only``)."""
-        return (grid or self._grid(known_only)).segment_is_free(a, b)
+        with self.timers("planning"):
+            return (grid or self._grid(known_only)).segment_is_free(a, b)
 
     # ----------------------------------------------------------------- driving
     def drive(
@@ -134,12 +140,15 @@ class Navigator:
             step = min(gap, self.lidar_every_m) if gap > 0 else 0.0
             point = target if step == gap else here + (target - here) * (step / gap)
             heading = math.atan2(target[1] - here[1], target[0] - here[0]) if gap > 0.2 else None
-            motion = self.platform.move_to(point, heading)
+            with self.timers("driving"):
+                motion = self.platform.move_to(point, heading)
             self.sense_lidar()
             self._since_camera += motion.distance
             if self._since_camera >= self.camera_every_m:
                 self._since_camera = 0.0
-                self.on_frame(self.platform.capture())
+                with self.timers("sensing"):
+                    frame = self.platform.capture()
+                self.on_frame(frame)
             if motion.blocked:
                 self.stats.blocked += 1
                 self.mark_contact(motion.contact)
@@ -175,7 +184,8 @@ class Navigator:
                 break
             self.stats.local_plans += 1
             try:
-                path = planner.plan(self.occupancy, self.platform.position, goal_point, radius)
+                with self.timers("planning"):
+                    path = planner.plan(self.occupancy, self.platform.position, goal_point, radius)
             except PlanningError:
                 self.stats.local_failures += 1
                 return False

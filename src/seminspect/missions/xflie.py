@@ -175,6 +175,7 @@ class XFlie:
             lidar_every_m=config.exploration.lidar_every_m,
             camera_every_m=config.exploration.camera_every_m,
             clear_misses_to=self.params.d_max,
+            timers=self.timers,
         )
         self.target_cloud = PointSet(TARGET_VOXEL)
         self.unreachable: set[str] = set()
@@ -268,8 +269,7 @@ class XFlie:
         frontiers = [f for f in frontiers if not self._failed_frontier(f.goal)]
         frontiers.sort(key=lambda f: float(np.linalg.norm((f.goal - here)[:2])))
         for frontier in frontiers[:5]:
-            with self.timers("planning"):
-                reached = self.navigator.go_to(frontier.goal, radius=1.5)
+            reached = self.navigator.go_to(frontier.goal, radius=1.5)
             if reached:
                 self._event("frontier", goal=frontier.goal.round(2).tolist(), cells=frontier.cells)
                 self.survey()
@@ -337,8 +337,7 @@ class XFlie:
         self._event("selected", target=target.id, utility=round(target.utility, 4))
         self._hierarchical_leg(goal)
         for radius in (self.params.epsilon, self.params.epsilon + 1.0, self.params.epsilon + 2.5):
-            with self.timers("planning"):
-                arrived = self.navigator.go_to(goal, radius, final_yaw=None)
+            arrived = self.navigator.go_to(goal, radius, final_yaw=None)
             if arrived:
                 self._event("arrived", target=target.id)
                 return True
@@ -380,8 +379,7 @@ class XFlie:
             plan = self.planner.plan(entry, here)
             self.record_plan(entry, plan)
             route = refine_path(plan.waypoints, self.navigator.segment_is_free).waypoints
-        with self.timers("driving"):
-            self.navigator.drive(route)
+        self.navigator.drive(route)
 
     # ----------------------------------------------------------------- inspection
     def inspect(self, target: TargetNode) -> None:
@@ -595,21 +593,16 @@ class XFlie:
         step = float(np.linalg.norm(goal - self.platform.position))
         if step < MIN_VIEW_STEP:
             return False
-        with self.timers("driving"):
-            if self.navigator.segment_is_free(self.platform.position, goal, known_only=known_only):
+        if self.navigator.segment_is_free(self.platform.position, goal, known_only=known_only):
+            with self.timers("driving"):
                 motion = self.platform.move_to(goal, yaw)
-                self.navigator.mark_contact(motion.contact)
-                self.navigator.sense_lidar()
-                if motion.reached:
-                    return True
-            with self.timers("planning"):
-                return self.navigator.go_to(
-                    goal,
-                    radius=min(0.5, 0.25 * step),
-                    final_yaw=yaw,
-                    attempts=2,
-                    known_only=known_only,
-                )
+            self.navigator.mark_contact(motion.contact)
+            self.navigator.sense_lidar()
+            if motion.reached:
+                return True
+        return self.navigator.go_to(
+            goal, radius=min(0.5, 0.25 * step), final_yaw=yaw, attempts=2, known_only=known_only
+        )
 
     def _climb(self, target: TargetNode, heights: list[float]) -> bool:
         """Start the next level one vertical step up, while the target rises above the view."""
