@@ -3,6 +3,7 @@ import pytest
 from seminspect.core.errors import InvalidInputError
 from seminspect.missions.config import (
     CITY_BUDGETS,
+    DEFAULT_BUDGET_S,
     MissionConfig,
     inspection_params,
     make_config,
@@ -19,7 +20,8 @@ def test_worlds_bring_their_papers_presets() -> None:
         "urban-simulated",
         "ground",
     )
-    assert city.time_budget_s == CITY_BUDGETS["medium"] == 1400.0  # 000 Sec VII-D
+    assert city.time_budget_s == DEFAULT_BUDGET_S  # a safety limit: missions end when done
+    assert CITY_BUDGETS == {"small": 700.0, "medium": 1400.0, "large": 2800.0}  # 000 Sec VII-D
     assert city.target_classes == ("car", "truck")
     collapsed = resolve(MissionConfig(world="collapsed-buildings", scenario="industrial"))
     assert (collapsed.preset, collapsed.mode, collapsed.target_classes) == (
@@ -28,7 +30,6 @@ def test_worlds_bring_their_papers_presets() -> None:
         ("building",),
     )
     assert inspection_params(collapsed).d_check_T == 8.0  # 000 Table 2
-    assert resolve(MissionConfig(scenario="large")).time_budget_s == 2800.0
 
 
 def test_explicit_settings_win_over_defaults() -> None:

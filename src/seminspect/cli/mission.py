@@ -30,7 +30,7 @@ def app(
         "city", "--world", "-w", help="Built-in world (seminspect world list)."
     ),
     scenario: str | None = typer.Option(
-        "medium", "--scenario", "-s", help="Scenario of the world (city: small, medium, large)."
+        None, "--scenario", "-s", help="Scenario of the world (default: the world's; city: medium)."
     ),
     seed: int = typer.Option(0, "--seed", help="Seed of the world, sensors and robot.", min=0),
     preset: str | None = typer.Option(
@@ -73,10 +73,6 @@ def app(
     from seminspect.missions.run import run_mission
     from seminspect.report.mission import render_run
 
-    if scenario is not None and scenario.lower() in {"", "none", "default"}:
-        scenario = None
-    if world != "city" and scenario == "medium":
-        scenario = None  # "medium" is the city's default; other worlds take their own
     config = make_config(
         {
             "world": world, "scenario": scenario, "seed": seed, "preset": preset,

@@ -22,6 +22,7 @@ One mission, step by step:
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
@@ -64,10 +65,14 @@ TARGET_VOXEL = 0.2
 ATTACHED = 1.5
 #: Fractions of the full view-planner step tried, in order, when a step is blocked.
 STEP_SCALES = (1.0, 0.5, 0.25)
+#: Fractions of the viewing distance tried, in order, when no step is free at the full one.
+VIEW_DISTANCE_SCALES = (1.0, 0.75)
 #: Every DEPTH_STRIDE-th pixel (rows and columns) of a depth frame goes into the map.
 DEPTH_STRIDE = 8
 #: A view move shorter than this does not count as a step along the surface [m].
 MIN_VIEW_STEP = 0.1
+#: Frontiers nearer than this to the robot (or to one already visited) are not worth a trip [m].
+FRONTIER_MIN_DISTANCE = 3.0
 #: No new target is started with less simulated time left than this [s].
 MIN_INSPECTION_S = 60.0
 #: Points this close to the ground are not part of a standing object [m].
@@ -179,7 +184,7 @@ class XFlie:
         )
         self.target_cloud = PointSet(TARGET_VOXEL)
         self.unreachable: set[str] = set()
-        self.failed_frontiers: list[NDArray[np.float64]] = []
+        self.spent_frontiers: list[NDArray[np.float64]] = []
         self.hierarchical: list[PlanningRecord] = []
         self.level_endings: dict[str, int] = {"similarity": 0, "cap": 0}
         self.phase = "start"
@@ -256,7 +261,12 @@ class XFlie:
         self._report()
 
     def explore(self) -> bool:
-        """Drive to the nearest reachable frontier and survey there; False if none is left."""
+        """Drive to the nearest reachable frontier and survey there; False if none is left.
+
+        Frontiers within ``FRONTIER_MIN_DISTANCE`` of the robot are skipped: they are the ring
+        of ground around its own body that no sensor sees, which no trip resolves. A frontier
+        visited or found unreachable is not chosen again.
+        """
         self._phase("explore-frontier")
         band = self.local.band or (self.platform.position[2] - 1.0, self.platform.position[2] + 1.0)
         frontiers = find_frontiers(
@@ -266,19 +276,28 @@ class XFlie:
             self.platform.position[2],
         )
         here = self.platform.position
-        frontiers = [f for f in frontiers if not self._failed_frontier(f.goal)]
-        frontiers.sort(key=lambda f: float(np.linalg.norm((f.goal - here)[:2])))
-        for frontier in frontiers[:5]:
-            reached = self.navigator.go_to(frontier.goal, radius=1.5)
-            if reached:
+
+        def distance(goal: NDArray[np.float64]) -> float:
+            return float(np.linalg.norm((goal - here)[:2]))
+
+        candidates = [
+            f
+            for f in frontiers
+            if distance(f.goal) >= FRONTIER_MIN_DISTANCE and not self._spent_frontier(f.goal)
+        ]
+        candidates.sort(key=lambda f: distance(f.goal))
+        for frontier in candidates[:5]:
+            self.spent_frontiers.append(frontier.goal)
+            if self.navigator.go_to(frontier.goal, radius=1.5):
                 self._event("frontier", goal=frontier.goal.round(2).tolist(), cells=frontier.cells)
                 self.survey()
                 return True
-            self.failed_frontiers.append(frontier.goal)
         return False
 
-    def _failed_frontier(self, goal: NDArray[np.float64]) -> bool:
-        return any(np.linalg.norm((goal - f)[:2]) < 3.0 for f in self.failed_frontiers)
+    def _spent_frontier(self, goal: NDArray[np.float64]) -> bool:
+        return any(
+            np.linalg.norm((goal - f)[:2]) < FRONTIER_MIN_DISTANCE for f in self.spent_frontiers
+        )
 
     # ----------------------------------------------------------------- perception
     def _capture(self) -> Frame:
@@ -560,13 +579,15 @@ class XFlie:
     def _step_along(self, surface: NDArray[np.float64], target: TargetNode) -> bool:
         """Move to the next view pose of 002 eqs (1)-(2); False when no step is possible.
 
-        When the full step is blocked, shorter steps along the surface are tried before giving
-        up.
+        When the full step is blocked, shorter steps along the surface are tried, and then the
+        same steps from closer to the surface (where the space around the target is too tight
+        for the viewing distance, as beside a car in a tunnel), before giving up.
         """
         points = self._surface_in_view(surface) if len(surface) else target.position[None, :]
-        for scale in STEP_SCALES:
+        for closer, scale in itertools.product(VIEW_DISTANCE_SCALES, STEP_SCALES):
+            overlap = 1.0 - (1.0 - self.view.overlap_h) * scale
             view = self.view.model_copy(
-                update={"overlap_h": 1.0 - (1.0 - self.view.overlap_h) * scale}
+                update={"overlap_h": overlap, "d_view": self.view.d_view * closer}
             )
             with self.timers("planning"):
                 try:
