@@ -3,18 +3,8 @@ from pathlib import Path
 
 import pytest
 
-from seminspect.cli import main
+from cli_runner import run
 from seminspect.graphs.lsg.io import load_graph
-
-
-def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
-    try:
-        main(list(args))
-        code = 0
-    except SystemExit as exit_:
-        code = int(exit_.code or 0)
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
 
 
 def test_version_and_help(capsys) -> None:

@@ -2,17 +2,7 @@ from pathlib import Path
 
 import pytest
 
-from seminspect.cli import main
-
-
-def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
-    try:
-        main(list(args))
-        code = 0
-    except SystemExit as exit_:
-        code = int(exit_.code or 0)
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
+from cli_runner import run
 
 
 def test_mission_runs_and_says_where_the_results_are(capsys, tmp_path: Path) -> None:

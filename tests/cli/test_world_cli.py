@@ -2,18 +2,8 @@ import json
 
 import pytest
 
-from seminspect.cli import main
+from cli_runner import run
 from seminspect.worlds import load_world
-
-
-def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
-    try:
-        main(list(args))
-        code = 0
-    except SystemExit as exit_:
-        code = int(exit_.code or 0)
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
 
 
 def test_list_shows_every_world(capsys) -> None:

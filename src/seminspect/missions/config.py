@@ -13,19 +13,13 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from seminspect.core.config import build
 from seminspect.core.params import PRESETS, InspectionParams, PresetName
+from seminspect.core.vocabulary import BUILDING_FEATURES, VEHICLE_PARTS
 
 Mode = Literal["ground", "aerial"]
 NoiseName = Literal["ideal", "realistic"]
 PlannerName = Literal["hierarchical", "volumetric"]
 
 VEHICLE_CLASSES = ("car", "truck")
-VEHICLE_FEATURES = (
-    "hood", "trunk", "front-bumper", "back-bumper", "front-glass", "back-glass",
-    "front-left-door", "front-right-door", "back-left-door", "back-right-door",
-    "front-left-wheel", "front-right-wheel", "back-left-wheel", "back-right-wheel",
-    "front-left-light", "front-right-light", "back-left-light", "back-right-light",
-)  # fmt: skip
-BUILDING_FEATURES = ("window", "person", "rubble")
 
 
 class _Strict(BaseModel):
@@ -148,7 +142,7 @@ def resolve(config: MissionConfig) -> MissionConfig:
             "mode": config.mode or defaults["mode"],
             "time_budget_s": config.time_budget_s or budget,
             "target_classes": config.target_classes or defaults.get("classes", VEHICLE_CLASSES),
-            "feature_labels": config.feature_labels or defaults.get("features", VEHICLE_FEATURES),
+            "feature_labels": config.feature_labels or defaults.get("features", VEHICLE_PARTS),
             "inspection": inspection,
         }
     )

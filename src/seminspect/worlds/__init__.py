@@ -1,12 +1,12 @@
 """Labelled triangle-mesh worlds (instance / class / part per face), generators and user worlds."""
 
+from seminspect.core.vocabulary import VEHICLE_PARTS
 from seminspect.worlds.builder import WorldBuilder
 from seminspect.worlds.catalog import WorldSpec, available_worlds, generate_world
 from seminspect.worlds.collision import CollisionMode
 from seminspect.worlds.raycast import RayCaster
 from seminspect.worlds.underground import mine_drift_pair
 from seminspect.worlds.user import insert_world, load_world, save_world
-from seminspect.worlds.vehicles import VEHICLE_PARTS
 from seminspect.worlds.world import BACKGROUND, GROUND, InstanceInfo, World
 
 __all__ = [

@@ -12,28 +12,6 @@ import numpy as np
 
 from seminspect.worlds.shapes import Piece, box, cylinder, pose_matrix, prism_xz, rotated_y_axis
 
-#: Every part a generated vehicle carries, besides ``body`` and ``roof``.
-VEHICLE_PARTS: tuple[str, ...] = (
-    "hood",
-    "trunk",
-    "front-bumper",
-    "back-bumper",
-    "front-glass",
-    "back-glass",
-    "front-left-door",
-    "front-right-door",
-    "back-left-door",
-    "back-right-door",
-    "front-left-wheel",
-    "front-right-wheel",
-    "back-left-wheel",
-    "back-right-wheel",
-    "front-left-light",
-    "front-right-light",
-    "back-left-light",
-    "back-right-light",
-)
-
 #: Nominal sizes (length, width, height) in metres.
 CAR_SIZE = (4.5, 1.9, 1.5)
 TRUCK_SIZE = (8.0, 2.5, 3.2)

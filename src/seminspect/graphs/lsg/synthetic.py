@@ -16,30 +16,11 @@ from scipy.spatial import cKDTree
 
 from seminspect.core.params import PRESETS, InspectionParams
 from seminspect.core.rng import make_rng
+from seminspect.core.vocabulary import VEHICLE_PARTS
 from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.perception.observation import Observation
 
-VEHICLE_PARTS = (
-    "hood",
-    "trunk",
-    "front-bumper",
-    "back-bumper",
-    "front-glass",
-    "back-glass",
-    "front-left-door",
-    "front-right-door",
-    "back-left-door",
-    "back-right-door",
-    "front-left-wheel",
-    "front-right-wheel",
-    "back-left-wheel",
-    "back-right-wheel",
-    "front-left-light",
-    "front-right-light",
-    "back-left-light",
-    "back-right-light",
-)
 #: Half-lengths, half-widths and heights (m) of the synthetic vehicles.
 _SIZE = {"car": (2.3, 0.95, 1.5), "truck": (4.0, 1.25, 3.2)}
 
