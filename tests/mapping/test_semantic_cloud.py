@@ -108,3 +108,62 @@ def test_save_load_round_trip_and_broken_files(tmp_path) -> None:
         load_cloud(other)
     with pytest.raises(FileFormatError, match="no such"):
         load_cloud(tmp_path / "missing.npz")
+
+
+def test_growing_cloud_matches_a_plain_running_mean() -> None:
+    # thousands of points: the buffers grow on the way, and later views put one or two scan
+    # points on a map point
+    rng = np.random.default_rng(3)
+    grid = np.stack(np.meshgrid(np.arange(60.0), np.arange(60.0), [0.0]), -1).reshape(-1, 3)
+    cloud = SemanticCloud.empty(4, "test")
+    sums, counts = np.zeros((len(grid), 4)), np.zeros(len(grid))
+    for view in range(6):
+        if view == 0:  # every anchor once, so that later duplicates have a map point to join
+            seen = rng.permutation(len(grid))
+        else:
+            seen = rng.choice(len(grid), 1500, replace=False)
+            seen = np.concatenate([seen, seen[:400]])
+        rows = rng.normal(size=(seen.size, 4)).astype(np.float32)
+        cloud.integrate(grid[seen] + rng.uniform(-0.1, 0.1, (seen.size, 3)), rows, radius=0.3)
+        np.add.at(sums, seen, rows)
+        np.add.at(counts, seen, 1)
+    assert len(cloud) == np.count_nonzero(counts)
+    anchor = np.round(cloud.points[:, 1]).astype(int) * 60 + np.round(cloud.points[:, 0]).astype(
+        int
+    )
+    np.testing.assert_array_equal(cloud.counts, counts[anchor])
+    np.testing.assert_allclose(cloud.embeddings, sums[anchor] / counts[anchor, None], atol=1e-5)
+
+
+def test_depth_image_hides_points_the_camera_cannot_see() -> None:
+    base = _segmentation()
+    depth = np.full(base.segment_ids.shape, 5.0, dtype=np.float32)
+    occluded = CameraSegmentation(base.segment_ids, base.embeddings, base.K,
+                                  base.T_camera_sensor, depth=depth)  # fmt: skip
+    points = np.array([[5.0, 1.0, 0.0], [9.0, -1.8, 0.0], [5.3, -1.0, 0.0]])
+    cloud = SemanticCloud.empty(2, "test")
+    stats = fuse_scan(cloud, points, np.eye(4), occluded, radius=0.1)
+    # the point 9 m away lies behind the 5 m surface the camera sees in its pixel
+    assert (stats.associated, stats.added) == (0, 2)
+    np.testing.assert_allclose(cloud.points, points[[0, 2]])
+    with pytest.raises(InvalidInputError, match="depth image"):
+        CameraSegmentation(base.segment_ids, base.embeddings, base.K, base.T_camera_sensor,
+                           depth=depth[:3])  # fmt: skip
+    with pytest.raises(InvalidInputError, match="tolerances"):
+        CameraSegmentation(base.segment_ids, base.embeddings, base.K, base.T_camera_sensor,
+                           depth=depth, depth_tolerance=-1.0)  # fmt: skip
+
+
+def test_source_record_round_trips_and_is_checked(tmp_path) -> None:
+    source = {"world": {"name": "outdoor", "scenario": "small", "seed": 2}, "frames": 7}
+    cloud = SemanticCloud(np.eye(3), np.eye(3, dtype=np.float32), np.ones(3, int), "enc", source)
+    again = load_cloud(save_cloud(tmp_path / "cloud.npz", cloud))
+    assert again.source == source
+    cloud.source = {"bad": object()}
+    with pytest.raises(InvalidInputError, match="not JSON"):
+        save_cloud(tmp_path / "bad.npz", cloud)
+    arrays = dict(np.load(tmp_path / "cloud.npz"))
+    arrays["source"] = np.array("[1, 2]")
+    np.savez(tmp_path / "hostile.npz", **arrays)
+    with pytest.raises(FileFormatError, match="source record"):
+        load_cloud(tmp_path / "hostile.npz")
