@@ -26,3 +26,12 @@ def test_colours_and_bad_views() -> None:
     assert class_colour("dragon") == class_colour("dragon")  # stable for unknown classes
     with pytest.raises(InvalidInputError, match="view"):
         world_figure(generate_world("room", "0"), "side")  # type: ignore[arg-type]
+
+
+def test_top_view_draws_the_drive_path() -> None:
+    world = generate_world("outdoor", "small", seed=0)
+    fig = world_figure(world, "top")
+    (line,) = [ln for ln in fig.axes[0].lines if ln.get_label() == "drive path"]
+    plt.close(fig)
+    assert line.get_xydata().tolist() == world.metadata["drive_path"]
+    assert len({class_colour(c) for c in ("sidewalk", "grass", "asphalt", "tree")}) == 4

@@ -9,7 +9,15 @@ CASES = [(spec.name, scenario) for spec in available_worlds() for scenario in sp
 
 def test_the_catalogue_lists_every_world() -> None:
     names = {spec.name for spec in available_worlds()}
-    assert names == {"city", "collapsed-buildings", "campus", "subterranean", "mine-drift", "room"}
+    assert names == {
+        "city",
+        "collapsed-buildings",
+        "campus",
+        "subterranean",
+        "mine-drift",
+        "room",
+        "outdoor",
+    }
     for spec in available_worlds():
         assert spec.default_scenario in spec.scenarios and spec.description
 
@@ -30,7 +38,9 @@ def test_every_world_is_deterministic_and_labelled(name, scenario) -> None:
     assert first.is_free([lifted], 0.4, "ground")[0]
 
 
-@pytest.mark.parametrize("name", ["city", "collapsed-buildings", "campus", "mine-drift", "room"])
+@pytest.mark.parametrize(
+    "name", ["city", "collapsed-buildings", "campus", "mine-drift", "room", "outdoor"]
+)
 def test_seeds_change_the_world(name) -> None:
     a, b = generate_world(name, seed=0), generate_world(name, seed=1)
     assert a.mesh.vertices.shape != b.mesh.vertices.shape or not np.array_equal(

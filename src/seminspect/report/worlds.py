@@ -42,6 +42,10 @@ CLASS_COLOURS: dict[str, str] = {
     "rock": "#5c4033",
     "target": "#d62728",
     "obstacle": "#7f8fa6",
+    "sidewalk": "#cfc8bc",
+    "grass": "#9cc987",
+    "asphalt": "#5f6268",
+    "tree": "#2e7d32",
 }
 #: Faces drawn in the 3D view at most; larger worlds are subsampled evenly.
 MAX_3D_FACES = 25_000
@@ -76,6 +80,9 @@ def draw_top_down(world: World, ax: Axes) -> None:
     for info in world.instances.values():
         if info.class_name != "building" or len(world.instances) < 40:
             ax.annotate(info.name, info.centroid[:2], fontsize=6, ha="center", va="center")
+    if world.metadata.get("drive_path"):
+        path = np.asarray(world.metadata["drive_path"], dtype=np.float64)
+        ax.plot(path[:, 0], path[:, 1], "--", color="crimson", linewidth=0.8, label="drive path")
     sx, sy = world.start_position[:2]
     ax.plot([sx], [sy], marker="*", color="crimson", markersize=10, label="start")
     ax.arrow(sx, sy, 2 * np.cos(world.start_yaw), 2 * np.sin(world.start_yaw), color="crimson")

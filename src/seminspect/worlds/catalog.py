@@ -8,7 +8,7 @@ from typing import Any
 
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.names import unknown_name
-from seminspect.worlds import campus, city, collapsed, rooms
+from seminspect.worlds import campus, city, collapsed, outdoor, rooms
 from seminspect.worlds.underground import generate_mine_drift, generate_subterranean
 from seminspect.worlds.world import World
 
@@ -73,6 +73,13 @@ WORLDS: dict[str, WorldSpec] = {
             "historical",
             generate_mine_drift,
             {"length": 40.0, "recession": 1.0, "obstacle": True},
+        ),
+        WorldSpec(
+            "outdoor",
+            "100 x 60 m sidewalks, grass and asphalt with 8 cars and 12 trees, a drive path (001)",
+            tuple(outdoor.SCENARIOS),
+            "block",
+            outdoor.generate_outdoor,
         ),
         WorldSpec(
             "room",
