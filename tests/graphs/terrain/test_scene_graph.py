@@ -1,10 +1,13 @@
+import copy
 import json
 
 import networkx as nx
 import numpy as np
 import pytest
+import shapely
 
 from seminspect.core.errors import FileFormatError, InvalidInputError, PlanningError
+from seminspect.graphs.terrain.evaluate import closest_class, score_places
 from seminspect.graphs.terrain.navigation import nearest_place, shortest_route
 from seminspect.graphs.terrain.params import make_terrain_params
 from seminspect.graphs.terrain.prompting import TaskPrompts
@@ -118,3 +121,33 @@ def test_impossible_parameters() -> None:
         make_terrain_params({"cell_size": 0})
     with pytest.raises(InvalidInputError, match="object_voxel"):
         make_terrain_params({"object_voxel": 2.0, "object_eps": 1.0})
+
+
+def test_places_are_scored_against_true_patches(build) -> None:
+    scene = build.scene
+    sidewalk = shapely.box(0.0, 0.0, 60.0, 3.0)  # the scene's sidewalk strip
+    mine = [n for n in scene.nodes_of("place") if scene.graph.nodes[n]["terrain"] == "sidewalk"]
+    good = score_places(scene, "sidewalk", [sidewalk, shapely.box(0.0, 40.0, 2.0, 42.0)])
+    # the 4 m^2 patch is below the minimum area and not scored
+    assert (good.patches, good.with_places, good.connected) == (1, 1, 1)
+    assert (good.places, good.off_terrain, good.all_connected) == (len(mine), 0, True)
+    elsewhere = score_places(scene, "sidewalk", [shapely.box(0.0, 10.0, 60.0, 13.0)])
+    assert (elsewhere.with_places, elsewhere.off_terrain) == (0, len(mine))
+    assert elsewhere.worst_offset > 6.0
+    cut = copy.deepcopy(scene)
+    a, b = next(
+        (a, b) for a, b, kind in cut.graph.subgraph(mine).edges(data="kind") if kind == "gvd"
+    )
+    cut.graph.remove_edge(a, b)
+    assert score_places(cut, "sidewalk", [sidewalk]).connected == 0
+    absent = score_places(scene, "sidewalk", [])
+    assert absent.patches == 0 and absent.off_terrain == len(mine)
+    assert absent.as_dict()["worst_offset"] is None  # infinite: no such terrain at all
+
+
+def test_prompts_meet_truth_classes_through_their_captions(fake_encoder) -> None:
+    classes = ["tree", "car", "grass"]
+    assert closest_class(fake_encoder, "image of a car", classes, 0.45) == "car"
+    assert closest_class(fake_encoder, "lawn", classes, 0.45) == "grass"  # a synonym
+    assert closest_class(fake_encoder, "image of a boat", classes, 0.45) is None
+    assert closest_class(fake_encoder, "image of a car", [], 0.45) is None

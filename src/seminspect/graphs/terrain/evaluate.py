@@ -1,14 +1,28 @@
-"""Object-layer quality against ground-truth instances: precision and recall at a box IoU."""
+"""Quality of a terrain scene graph against ground truth (001 Sec IV, where truth is known).
+
+- Objects: predicted boxes matched one-to-one with true boxes; precision and recall at a box IoU.
+- Places: for each true patch of a terrain, whether its places form one connected GVD graph,
+  and whether any place lies off every patch of its terrain.
+- Prompts meet ground-truth class names through the encoder: a prompt scores against the class
+  whose caption it is most similar to, when that similarity reaches the prompt's threshold.
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+from typing import Any
 
+import networkx as nx
 import numpy as np
+import shapely
 from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
+from shapely.geometry import Polygon
 
+from seminspect.core.io import finite_or_none
 from seminspect.graphs.terrain.scene_graph import TerrainSceneGraph
+from seminspect.perception.encoders import TextEncoder, caption
 
 Box = tuple[NDArray[np.float64], NDArray[np.float64]]
 
@@ -30,6 +44,17 @@ class ObjectScores:
     @property
     def recall(self) -> float:
         return self.matched / self.ground_truth if self.ground_truth else 0.0
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "iou_threshold": self.threshold,
+            "predicted": self.predicted,
+            "ground_truth": self.ground_truth,
+            "matched": self.matched,
+            "precision": self.precision,
+            "recall": self.recall,
+            "mean_iou": self.mean_iou,
+        }
 
 
 def box_iou(first: Box, second: Box) -> float:
@@ -60,3 +85,95 @@ def predicted_boxes(scene: TerrainSceneGraph, prompt: str) -> list[Box]:
         for n in scene.nodes_of("object")
         if graph.nodes[n]["label"] == prompt
     ]
+
+
+def closest_class(
+    encoder: TextEncoder, prompt: str, classes: Sequence[str], threshold: float
+) -> str | None:
+    """The class whose caption is most similar to ``prompt``, or ``None`` below ``threshold``."""
+    if not classes:
+        return None
+    captions = encoder.encode_text([caption(name) for name in classes])
+    similarity = captions @ encoder.encode_text([prompt])[0]
+    best = int(np.argmax(similarity))
+    return classes[best] if similarity[best] >= threshold else None
+
+
+@dataclass(frozen=True)
+class PlaceScores:
+    """The places of one terrain prompt against the true patches of its class.
+
+    Attributes:
+        terrain: the terrain prompt.
+        patches: true patches of at least the minimum area (the ones scored).
+        with_places: of those, patches that hold at least one place.
+        connected: of those, patches whose places form one graph over ``gvd`` edges.
+        places: places of the prompt.
+        off_terrain: places farther than the tolerance from every patch of the class.
+        worst_offset: the largest distance of a place from the class's patches (0: inside;
+            infinite when the world has no patch of the class).
+    """
+
+    terrain: str
+    patches: int
+    with_places: int
+    connected: int
+    places: int
+    off_terrain: int
+    worst_offset: float
+
+    @property
+    def all_connected(self) -> bool:
+        """Every scored patch got a connected place graph."""
+        return self.connected == self.patches
+
+    def as_dict(self) -> dict[str, Any]:
+        record = {**asdict(self), "all_connected": self.all_connected}
+        return {**record, "worst_offset": finite_or_none(self.worst_offset)}
+
+
+def score_places(
+    scene: TerrainSceneGraph,
+    terrain: str,
+    patches: Sequence[Polygon],
+    *,
+    min_area: float = 10.0,
+    tolerance: float = 0.5,
+) -> PlaceScores:
+    """Score the places of ``terrain`` against the true ``patches`` of its class.
+
+    A place belongs to the patch it lies in (within ``tolerance``, half a grid cell or so, since
+    places sit at cell centres); patches smaller than ``min_area`` square metres are not scored.
+    """
+    graph = scene.graph
+    places = [n for n in scene.nodes_of("place") if graph.nodes[n]["terrain"] == terrain]
+    xy = np.array([graph.nodes[n]["position"][:2] for n in places]).reshape(-1, 2)
+    points = shapely.points(xy)
+    offsets = (
+        shapely.distance(shapely.union_all(list(patches)), points)
+        if patches
+        else np.full(len(places), np.inf)  # the world has no such terrain
+    )
+    scored = [p for p in patches if p.area >= min_area]
+    with_places = connected = 0
+    for patch in scored:
+        zone = patch.buffer(tolerance)
+        inside = [n for n, point in zip(places, points, strict=True) if zone.contains(point)]
+        if not inside:
+            continue
+        with_places += 1
+        links = nx.Graph()
+        links.add_nodes_from(inside)
+        links.add_edges_from(
+            (a, b) for a, b, kind in graph.subgraph(inside).edges(data="kind") if kind == "gvd"
+        )
+        connected += int(nx.is_connected(links))
+    return PlaceScores(
+        terrain=terrain,
+        patches=len(scored),
+        with_places=with_places,
+        connected=connected,
+        places=len(places),
+        off_terrain=int(np.sum(offsets > tolerance)),
+        worst_offset=float(offsets.max(initial=0.0)),
+    )
