@@ -34,14 +34,49 @@ def test_graph_command_end_to_end_on_a_small_cloud(tmp_path, labelled_scene, fak
     assert route.exit_code == 0 and "1 places" in route.output
 
 
-def test_errors_are_one_line_and_exit_non_zero(tmp_path, capsys) -> None:
+def test_map_then_graph_evaluates_against_the_simulated_world(tmp_path, fake_encoder) -> None:
+    cloud = tmp_path / "cloud.npz"
+    mapped = runner.invoke(
+        app,
+        ["terrain", "map", "--world", "outdoor", "-s", "small", "--seed", "0",
+         "--encoder", "hashing-test", "--spacing", "3", "--out", str(cloud)],
+    )  # fmt: skip
+    assert mapped.exit_code == 0, mapped.output
+    assert "29 frames" in mapped.output and cloud.stat().st_size > 0
+    out = tmp_path / "graph"
+    graph = runner.invoke(
+        app,
+        ["terrain", "graph", str(cloud), "--encoder", "hashing-test", "--terrain-threshold",
+         "0.3", "--terrain", "sidewalk,grass,asphalt", "--objects",
+         "image of a tree,image of a car", "--evaluate", "--out", str(out)],
+    )  # fmt: skip
+    assert graph.exit_code == 0, graph.output
+    quality = json.loads((out / "summary.json").read_text())["quality"]
+    cars = quality["objects"]["image of a car"]
+    assert (cars["ground_truth"], cars["precision"], cars["recall"]) == (2, 1.0, 1.0)
+    assert all(p["all_connected"] and p["off_terrain"] == 0 for p in quality["places"].values())
+    assert (out / "gvd_2_asphalt.png").stat().st_size > 0
+
+
+def test_errors_are_one_line_and_exit_non_zero(
+    tmp_path, capsys, labelled_scene, fake_encoder
+) -> None:
     broken = tmp_path / "broken.pcd"
     broken.write_bytes(b"VERSION 0.7\nFIELDS x y z\n")
+    points, labels, _ = labelled_scene
+    plain = tmp_path / "plain.npz"
+    np.savez(plain, points=points, labels=labels)
+    cloud = str(tmp_path / "c.npz")
     for argv in (
         ["terrain", "graph", str(broken), "--out", str(tmp_path / "o")],
         ["terrain", "graph", str(broken), "--out", str(tmp_path / "o"), "--encoder", "nope"],
         ["terrain", "graph", str(broken), "--out", str(tmp_path / "o"), "--param", "cell_size=0"],
-    ):
+        ["terrain", "graph", str(plain), "--out", str(tmp_path / "o"), "--label-names",
+         "0=sidewalk,1=grass,2=road,3=car,4=tree", "--encoder", "hashing-test", "--evaluate"],
+        ["terrain", "map", "--world", "outdor", "--out", cloud],
+        ["terrain", "map", "--world", "city", "-s", "small", "--out", cloud],
+        ["terrain", "map", "-s", "small", "--spacing", "0", "--out", cloud],
+    ):  # fmt: skip
         try:
             main(argv)
         except SystemExit as exc:

@@ -9,7 +9,7 @@ from seminspect.core.errors import InvalidInputError, PlanningError
 from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.graphs.terrain.prompting import TaskPrompts
 from seminspect.graphs.terrain.scene_graph import build_terrain_graph
-from seminspect.mapping.semantic_cloud import transform_points
+from seminspect.mapping.semantic_cloud import SemanticCloud, transform_points
 from seminspect.missions.terrain_mapping import (
     MappingParams,
     SensorRig,
@@ -19,6 +19,7 @@ from seminspect.missions.terrain_mapping import (
     make_mapping_params,
     map_world,
     rig_poses,
+    source_world,
 )
 from seminspect.perception.encoders import Calibration
 from seminspect.sensors import render
@@ -107,6 +108,8 @@ def test_mapping_fuses_many_views_per_point_and_records_its_source(world, mapped
         "options": {},
     }
     assert cloud.source["frames"] == run.frames and cloud.source["spacing"] == 3.0
+    again = source_world(cloud)
+    np.testing.assert_array_equal(again.mesh.vertices, world.mesh.vertices)
     assert set(run.seconds) == {"sensors", "segments", "fusion", "total"}
 
 
@@ -150,3 +153,11 @@ def test_bad_worlds_paths_and_parameters_are_refused(world, fake_encoder) -> Non
         make_mapping_params({"spacing": 0})
     with pytest.raises(InvalidInputError, match="radius"):
         make_mapping_params({"radius": "wide"})
+
+
+def test_source_records_without_a_usable_world(fake_encoder) -> None:
+    cloud = SemanticCloud.empty(fake_encoder.dim, fake_encoder.name)
+    assert source_world(cloud) is None
+    cloud.source = {"world": {"name": "outdoor", "seed": 0}}
+    with pytest.raises(InvalidInputError, match="no usable world"):
+        source_world(cloud)

@@ -82,39 +82,46 @@ def _load_cloud(inputs: list[Path], labels: list[Path], options: dict[str, Any],
     return cloud_from_point_data(load_point_file(source), encoder, names), None
 
 
-def _quality(build, fused, encoder) -> dict[str, Any]:
-    """Object precision/recall against the scans' own instance labels."""
-    import numpy as np
+def _encoder(name: str, noise: float, seed: int):
+    """A registered or plug-in encoder; a caption encoder gets ``noise`` per view."""
+    import dataclasses
 
-    from seminspect.graphs.terrain.evaluate import match_boxes, predicted_boxes
+    from seminspect.perception.encoders import CaptionEncoder, make_encoder
+
+    encoder = make_encoder(name)
+    if noise and isinstance(encoder, CaptionEncoder):
+        encoder = dataclasses.replace(encoder, noise=noise, seed=seed)
+    return encoder
+
+
+def _kitti_quality(build, fused, encoder) -> dict[str, Any]:
+    """Object precision/recall against the scans' own instance labels."""
+    from seminspect.graphs.terrain.evaluate import closest_class, match_boxes, predicted_boxes
     from seminspect.mapping.semantickitti import instance_boxes, label_table
-    from seminspect.perception.encoders import caption
 
     things = label_table().thing_classes()
-    classes = sorted(things)
-    captions = encoder.encode_text([caption(things[c]) for c in classes])
+    ids = {name: label for label, name in things.items()}
     report: dict[str, Any] = {}
     for prompt in build.scene.prompts.objects:
-        similarity = captions @ encoder.encode_text([prompt])[0]
-        best = int(np.argmax(similarity))
-        if similarity[best] < build.scene.calibration.objects:
+        truth = closest_class(encoder, prompt, list(ids), build.scene.calibration.objects)
+        if truth is None:
             report[prompt] = {"ground_truth_class": None}
             continue
-        truth = instance_boxes(
-            fused.points, fused.semantic, fused.instance, classes[best], min_points=1
+        boxes = instance_boxes(
+            fused.points, fused.semantic, fused.instance, ids[truth], min_points=1
         )
-        scores = match_boxes(predicted_boxes(build.scene, prompt), truth, threshold=0.3)
-        report[prompt] = {
-            "ground_truth_class": things[classes[best]],
-            "iou_threshold": scores.threshold,
-            "predicted": scores.predicted,
-            "ground_truth": scores.ground_truth,
-            "matched": scores.matched,
-            "precision": scores.precision,
-            "recall": scores.recall,
-            "mean_iou": scores.mean_iou,
-        }
+        scores = match_boxes(predicted_boxes(build.scene, prompt), boxes, threshold=0.3)
+        report[prompt] = {"ground_truth_class": truth, **scores.as_dict()}
     return report
+
+
+def _quality(build, cloud, fused, encoder) -> dict[str, Any]:
+    """Scores against the scans' instance labels, or against the simulated world's truth."""
+    from seminspect.missions.terrain_mapping import evaluate_on_world, source_world
+
+    if fused is not None:
+        return _kitti_quality(build, fused, encoder)
+    return evaluate_on_world(build, source_world(cloud), encoder)
 
 
 def _write_outputs(out: Path, build, cloud, progress) -> None:
@@ -171,7 +178,9 @@ def graph(
     cell_size: float | None = typer.Option(None, help="Terrain grid cell size [m]."),
     param: list[str] = typer.Option([], help="Any graph parameter as NAME=VALUE (repeatable)."),
     evaluate: bool = typer.Option(
-        False, help="Score objects against the scans' instance labels (SemanticKITTI)."
+        False,
+        help="Score against ground truth: SemanticKITTI instance labels, or the simulated "
+        "world a 'terrain map' cloud came from.",
     ),
 ) -> None:
     import dataclasses
@@ -184,13 +193,11 @@ def graph(
     from seminspect.graphs.terrain.params import make_terrain_params
     from seminspect.graphs.terrain.prompting import TaskPrompts
     from seminspect.graphs.terrain.scene_graph import build_terrain_graph
-    from seminspect.perception.encoders import CaptionEncoder, calibration_for, make_encoder
+    from seminspect.perception.encoders import calibration_for
 
     prompts = TaskPrompts.parse(terrain, objects)
     params = make_terrain_params(_param_overrides(param, cell_size))
-    encoder = make_encoder(encoder_name)
-    if noise and isinstance(encoder, CaptionEncoder):
-        encoder = dataclasses.replace(encoder, noise=noise, seed=seed)
+    encoder = _encoder(encoder_name, noise, seed)
     calibration = calibration_for(encoder.name)
     if terrain_threshold is not None or object_threshold is not None:
         calibration = dataclasses.replace(
@@ -201,6 +208,11 @@ def graph(
     options = {"poses": poses, "calib": calib, "radius": radius, "label_names": label_names}
     with Progress(console=console, transient=True) as progress:
         cloud, fused = _load_cloud(inputs, labels, options, encoder, progress)
+        if evaluate and fused is None and "world" not in cloud.source:
+            raise InvalidInputError(
+                "--evaluate needs SemanticKITTI scans with instance labels "
+                "or a cloud from 'seminspect terrain map'"
+            )
         stages = progress.add_task("phase 2", total=5)
 
         def on_stage(name: str) -> None:
@@ -209,9 +221,7 @@ def graph(
         build = build_terrain_graph(
             cloud, prompts, encoder, params=params, calibration=calibration, on_stage=on_stage
         )
-        if evaluate and fused is None:
-            raise InvalidInputError("--evaluate needs SemanticKITTI scans with instance labels")
-        quality = _quality(build, fused, encoder) if evaluate else None
+        quality = _quality(build, cloud, fused, encoder) if evaluate else None
         _write_outputs(out, build, cloud, progress)
     summary = {
         "cloud_points": len(cloud),
@@ -239,3 +249,53 @@ def route(
     allowed = [t.strip() for t in terrain.split(",") if t.strip()] if terrain else None
     places, length = shortest_route(scene, start, goal, allowed)
     console.print(f"{len(places)} places, {length:.1f} m: " + " -> ".join(places))
+
+
+@app.command("map")
+def map_command(
+    out: Path = typer.Option(..., "--out", help="The semantic cloud to write (.npz)."),
+    world: str = typer.Option("outdoor", help="Built-in world with a drive path."),
+    scenario: str | None = typer.Option(
+        None, "--scenario", "-s", help="World scenario (the world's default when omitted)."
+    ),
+    seed: int = typer.Option(0, help="Seed of the world and of the caption noise."),
+    encoder_name: str = typer.Option(
+        "minilm", "--encoder", help="Registered encoder name or package.module:factory."
+    ),
+    noise: float = typer.Option(0.3, help="Caption noise per view (caption encoders)."),
+    spacing: float = typer.Option(1.0, help="Metres driven between frames."),
+    radius: float = typer.Option(0.15, help="Association radius of scan points to map points [m]."),
+) -> None:
+    """Phase 1 (001 Sec III-A) in the simulator: drive a world's path, fuse LiDAR and camera.
+
+    Writes the metric-semantic cloud that 'seminspect terrain graph' reads; the cloud remembers
+    its world, so 'terrain graph CLOUD --evaluate' scores the graph against that world.
+    """
+    from rich.progress import MofNCompleteColumn, Progress, TimeElapsedColumn
+
+    from seminspect.mapping.semantic_cloud import save_cloud
+    from seminspect.missions.terrain_mapping import make_mapping_params, map_world
+    from seminspect.worlds import generate_world
+
+    params = make_mapping_params({"spacing": spacing, "radius": radius})
+    site = generate_world(world, scenario, seed)
+    encoder = _encoder(encoder_name, noise, seed)
+    columns = (*Progress.get_default_columns()[:2], MofNCompleteColumn(), TimeElapsedColumn())
+    with Progress(*columns, console=console, transient=True) as progress:
+        task = progress.add_task("phase 1: scanning and fusing", total=None)
+        run = map_world(
+            site,
+            encoder,
+            params=params,
+            on_frame=lambda done, total: progress.update(task, completed=done, total=total),
+        )
+    save_cloud(out, run.cloud)
+    seconds = run.seconds
+    console.print(
+        f"[bold]semantic cloud[/] written to {out}: {len(run.cloud):,} points from "
+        f"{run.frames} frames over {run.distance:.0f} m, {run.cloud.counts.mean():.1f} views "
+        f"per point; {seconds['total']:.1f} s ({1000 * seconds['total'] / run.frames:.0f} ms "
+        f"per frame: sensors {seconds['sensors']:.1f} s, segments {seconds['segments']:.1f} s, "
+        f"fusion {seconds['fusion']:.1f} s)",
+        highlight=False,
+    )

@@ -35,7 +35,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from scipy import ndimage
 
 from seminspect.core.config import build
-from seminspect.core.errors import PlanningError
+from seminspect.core.errors import InvalidInputError, PlanningError
 from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.graphs.terrain.evaluate import (
     closest_class,
@@ -53,7 +53,7 @@ from seminspect.mapping.semantic_cloud import (
 from seminspect.perception.encoders import Encoder, Segment, TextEncoder
 from seminspect.robot import Robot
 from seminspect.sensors import CameraModel, Frame, Lidar, render
-from seminspect.worlds import World
+from seminspect.worlds import World, generate_world
 from seminspect.worlds.outdoor import drive_path, terrain_patches
 from seminspect.worlds.shapes import pose_matrix
 
@@ -195,6 +195,21 @@ def _world_source(world: World, params: MappingParams, frames: int) -> dict[str,
             "options": world.metadata.get("options", {}),
         }
     return source
+
+
+def source_world(cloud: SemanticCloud) -> World | None:
+    """The built-in world a cloud was mapped in, regenerated from its source record, if any."""
+    spec = cloud.source.get("world")
+    if spec is None:
+        return None
+    try:
+        return generate_world(
+            spec["name"], spec["scenario"], int(spec["seed"]), **dict(spec["options"])
+        )
+    except (KeyError, TypeError, ValueError) as exc:
+        raise InvalidInputError(
+            f"the cloud's source record names no usable world ({exc})"
+        ) from None
 
 
 def map_world(
