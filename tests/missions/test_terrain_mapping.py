@@ -124,6 +124,7 @@ def test_quality_on_the_small_world_meets_the_targets(world, mapped, fake_encode
     for terrain in PROMPTS.terrain:
         places = quality["places"][terrain]
         assert places["ground_truth_class"] == terrain and places["patches"] >= 1
+        assert places["points_on_terrain"] > 0.97
         assert places["all_connected"] and places["off_terrain"] == 0, places
 
 

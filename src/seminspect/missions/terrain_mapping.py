@@ -30,9 +30,11 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+import shapely
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field
 from scipy import ndimage
+from shapely.geometry import Polygon
 
 from seminspect.core.config import build
 from seminspect.core.errors import InvalidInputError, PlanningError
@@ -43,6 +45,7 @@ from seminspect.graphs.terrain.evaluate import (
     predicted_boxes,
     score_places,
 )
+from seminspect.graphs.terrain.prompting import TaskPoints
 from seminspect.graphs.terrain.scene_graph import TerrainBuild
 from seminspect.mapping.semantic_cloud import (
     CameraSegmentation,
@@ -313,7 +316,8 @@ def evaluate_on_world(
     Objects: the nodes of each object prompt against the world's objects of the class the
     prompt names (precision and recall at ``iou``). Places: for each terrain prompt, the true
     patches of its class (:func:`~seminspect.graphs.terrain.evaluate.score_places`, tolerance
-    one grid cell, since places sit at cell centres and closing grows a grid by up to a cell).
+    one grid cell, since places sit at cell centres and closing grows a grid by up to a cell),
+    and the share of the prompt's layer-1 points that lie on those patches.
     """
     scene = build.scene
     objects: dict[str, Any] = {}
@@ -332,5 +336,20 @@ def evaluate_on_world(
         scores = score_places(
             scene, prompt, mine, min_area=min_patch_area, tolerance=scene.params.cell_size
         )
-        places[prompt] = {"ground_truth_class": truth, **scores.as_dict()}
+        places[prompt] = {
+            "ground_truth_class": truth,
+            "points_on_terrain": _points_on(scene.layer1, prompt, mine),
+            **scores.as_dict(),
+        }
     return {"objects": objects, "places": places}
+
+
+def _points_on(layer: TaskPoints | None, prompt: str, patches: list[Polygon]) -> float | None:
+    """Share of a terrain prompt's layer-1 points that lie on a true patch of its class."""
+    rows = layer.of(prompt) if layer is not None else np.zeros(0, np.int64)
+    if rows.size == 0:
+        return None
+    if not patches:
+        return 0.0
+    xy = layer.points[rows, :2]
+    return float(shapely.intersects_xy(shapely.union_all(patches), xy[:, 0], xy[:, 1]).mean())
