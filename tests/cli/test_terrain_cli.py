@@ -1,25 +1,23 @@
 import json
 
 import numpy as np
-from typer.testing import CliRunner
 
-from seminspect.cli import app, main
-
-runner = CliRunner()
+from cli_runner import run
 
 
-def test_graph_command_end_to_end_on_a_small_cloud(tmp_path, labelled_scene, fake_encoder) -> None:
+def test_graph_command_end_to_end_on_a_small_cloud(
+    capsys, tmp_path, labelled_scene, fake_encoder
+) -> None:
     points, labels, names = labelled_scene
     cloud = tmp_path / "scene.npz"
     np.savez(cloud, points=points, labels=labels)
     out = tmp_path / "out"
     spec = ",".join(f"{k}={v}" for k, v in names.items())
-    result = runner.invoke(
-        app,
-        ["terrain", "graph", str(cloud), "--out", str(out), "--encoder", "hashing-test",
-         "--label-names", spec, "--param", "split_length=6.0"],
+    code, _, err = run(
+        capsys, "terrain", "graph", str(cloud), "--out", str(out), "--encoder", "hashing-test",
+        "--label-names", spec, "--param", "split_length=6.0",
     )  # fmt: skip
-    assert result.exit_code == 0, result.output
+    assert code == 0, err
     summary = json.loads((out / "summary.json").read_text())
     assert summary["objects"] == {"image of a tree": 2, "image of a car": 3}
     assert all(n > 0 for n in summary["places"].values())
@@ -28,29 +26,29 @@ def test_graph_command_end_to_end_on_a_small_cloud(tmp_path, labelled_scene, fak
         assert (out / name).stat().st_size > 0, name
     graph = json.loads((out / "graph.json").read_text())
     places = [n["id"] for n in graph["nodes"] if n["kind"] == "place"]
-    route = runner.invoke(
-        app, ["terrain", "route", str(out / "graph.json"), "--from", places[0], "--to", places[0]]
+    code, out_text, _ = run(
+        capsys, "terrain", "route", str(out / "graph.json"), "--from", places[0], "--to", places[0]
     )
-    assert route.exit_code == 0 and "1 places" in route.output
+    assert code == 0 and "1 places" in out_text
 
 
-def test_map_then_graph_evaluates_against_the_simulated_world(tmp_path, fake_encoder) -> None:
+def test_map_then_graph_evaluates_against_the_simulated_world(
+    capsys, tmp_path, fake_encoder
+) -> None:
     cloud = tmp_path / "cloud.npz"
-    mapped = runner.invoke(
-        app,
-        ["terrain", "map", "--world", "outdoor", "-s", "small", "--seed", "0",
-         "--encoder", "hashing-test", "--spacing", "3", "--out", str(cloud)],
+    code, out_text, err = run(
+        capsys, "terrain", "map", "--world", "outdoor", "-s", "small", "--seed", "0",
+        "--encoder", "hashing-test", "--spacing", "3", "--out", str(cloud),
     )  # fmt: skip
-    assert mapped.exit_code == 0, mapped.output
-    assert "29 frames" in mapped.output and cloud.stat().st_size > 0
+    assert code == 0, err
+    assert "29 frames" in out_text and cloud.stat().st_size > 0
     out = tmp_path / "graph"
-    graph = runner.invoke(
-        app,
-        ["terrain", "graph", str(cloud), "--encoder", "hashing-test", "--terrain-threshold",
-         "0.3", "--terrain", "sidewalk,grass,asphalt", "--objects",
-         "image of a tree,image of a car", "--evaluate", "--out", str(out)],
+    code, _, err = run(
+        capsys, "terrain", "graph", str(cloud), "--encoder", "hashing-test",
+        "--terrain-threshold", "0.3", "--terrain", "sidewalk,grass,asphalt", "--objects",
+        "image of a tree,image of a car", "--evaluate", "--out", str(out),
     )  # fmt: skip
-    assert graph.exit_code == 0, graph.output
+    assert code == 0, err
     quality = json.loads((out / "summary.json").read_text())["quality"]
     cars = quality["objects"]["image of a car"]
     assert (cars["ground_truth"], cars["precision"], cars["recall"]) == (2, 1.0, 1.0)
@@ -77,9 +75,5 @@ def test_errors_are_one_line_and_exit_non_zero(
         ["terrain", "map", "--world", "city", "-s", "small", "--out", cloud],
         ["terrain", "map", "-s", "small", "--spacing", "0", "--out", cloud],
     ):  # fmt: skip
-        try:
-            main(argv)
-        except SystemExit as exc:
-            assert exc.code == 1
-        error = capsys.readouterr().err.strip()
-        assert error.startswith("error:") and "\n" not in error, error
+        code, _, err = run(capsys, *argv)
+        assert code == 1 and err.startswith("error:") and "\n" not in err.strip(), err

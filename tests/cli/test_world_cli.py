@@ -9,7 +9,8 @@ from seminspect.worlds import load_world
 def test_list_shows_every_world(capsys) -> None:
     code, out, _ = run(capsys, "world", "list")
     assert code == 0
-    for name in ("city", "collapsed-buildings", "campus", "subterranean", "mine-drift", "room"):
+    for name in ("city", "collapsed-buildings", "campus", "subterranean", "mine-drift", "room",
+                 "outdoor"):  # fmt: skip
         assert name in out
 
 

@@ -298,4 +298,5 @@ def map_command(
         f"per frame: sensors {seconds['sensors']:.1f} s, segments {seconds['segments']:.1f} s, "
         f"fusion {seconds['fusion']:.1f} s)",
         highlight=False,
+        soft_wrap=True,
     )
