@@ -1,6 +1,7 @@
 """End to end: a small mission, its run directory, interruption and failure."""
 
 import json
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -9,6 +10,7 @@ import pytest
 from seminspect.core.errors import SeminspectError
 from seminspect.core.io import read_versioned_json
 from seminspect.graphs.lsg.io import load_graph
+from seminspect.graphs.lsg.model import EdgeKind
 from seminspect.missions.config import make_config
 from seminspect.missions.run import run_mission
 from seminspect.missions.xflie import XFlie
@@ -114,3 +116,14 @@ def test_a_failure_mid_mission_is_recorded_and_reported(tmp_path: Path, monkeypa
     status = read_versioned_json(tmp_path / "run" / "status.json", "seminspect.run-status", [1])
     assert status["state"] == "failed" and "camera unplugged" in status["reason"]
     assert load_graph(tmp_path / "run" / "graph.json").targets()  # what was found survives
+
+
+def test_every_edge_of_the_graph_is_traversable_in_the_world(small_mission) -> None:
+    graph, world = small_mission.mission.graph, small_mission.world
+    radius = small_mission.mission.config.robot.radius
+    spatial = [e for e in graph.edges() if e.kind is EdgeKind.SPATIAL]
+    assert len(spatial) > 40
+    for edge in spatial:
+        path = graph.edge_path(edge)
+        for a, b in pairwise(path):
+            assert world.segment_is_free(a, b, radius, "ground"), (edge.u, edge.v)

@@ -415,6 +415,7 @@ class XFlie:
             if level > 0 and not self._climb(target, heights):
                 break
             self._inspect_level(target, heights)
+            self._close_level()
             if self.config.mode != "aerial" or self.time_left <= 0:
                 break
         if len(LayeredSemanticGraph.entry_level(target).poses) < 3:
@@ -632,15 +633,43 @@ class XFlie:
         reach = self.view.d_view * math.tan(half - self.camera_pitch)
         if self.platform.position[2] + reach >= top:
             return False
-        goal = self.platform.position + np.array([0.0, 0.0, self.view.vertical_step])
+        here = self.platform.position
+        goal = here + np.array([0.0, 0.0, self.view.vertical_step])
         with self.timers("driving"):
             motion = self.platform.move_to(goal, self.platform.yaw)
         if not motion.reached:
             return False
         with self.timers("graph"):
-            self.graph.begin_level(self._view_pose(image=None))
+            self.graph.begin_level(self._view_pose(image=None), via=self._climb_route(here))
         self._event("level", target=target.id, height=round(float(goal[2]), 2))
         return True
+
+    def _close_level(self) -> None:
+        """Eq (10) for the level just inspected. Its ring edge (last pose back to the level's
+        start) is a straight segment the robot never drove, so it is added only where the
+        robot's map shows that segment free (known space, the planners' clearance)."""
+        level = self.graph.current_level
+        assert level is not None
+        poses = level.poses
+        ring = len(poses) > 1 and self.navigator.segment_is_free(
+            poses[-1].position, level.position, known_only=True
+        )
+        with self.timers("graph"):
+            self.graph.close_level(close_ring=ring)
+        if len(poses) > 1 and not ring:
+            self._event("ring-left-open", level=level.id)
+
+    def _climb_route(self, climb_start: NDArray[np.float64]) -> NDArray[np.float64]:
+        """How the robot got from the closing level's start to where it climbed: through the
+        ring edge when the level kept it, otherwise along its view poses as it drove them."""
+        level = self.graph.current_level
+        assert level is not None
+        poses = level.poses
+        ring = len(poses) > 1 and self.graph.edge(poses[-1].id, level.id) is not None
+        chain = [p.position for p in (poses[-1:] if ring else poses)]
+        if not chain or np.linalg.norm(chain[-1] - climb_start) > 1e-9:
+            chain.append(climb_start)
+        return np.array(chain)
 
     def _connect_inspected(self, target: TargetNode) -> None:
         """``v_I - v_I`` edges to the nearest inspected targets, through known free space."""

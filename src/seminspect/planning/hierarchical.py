@@ -110,6 +110,21 @@ class _LocalIndex:
     csr: CsrGraph
     #: Nodes ``0 .. n_levels - 1`` are levels (``Level-0`` first), the rest are poses.
     n_levels: int
+    #: Via points of edges realised by a polyline, by (from, to) node, in travel order.
+    vias: dict[tuple[int, int], NDArray[np.float64]]
+
+    def points(self, nodes: NDArray[np.int64]) -> NDArray[np.float64]:
+        """The metric path through ``nodes``: their positions and any via points between."""
+        coords = self.csr.coords[nodes]
+        if not self.vias:
+            return coords
+        chunks = [coords[:1]]
+        for k, step in enumerate(pairwise(nodes.tolist())):
+            via = self.vias.get(step)
+            if via is not None:
+                chunks.append(via)
+            chunks.append(coords[k + 1 : k + 2])
+        return np.concatenate(chunks)
 
 
 @dataclass(slots=True)
@@ -263,7 +278,12 @@ class HierarchicalPlanner:
             [(index[e.u], index[e.v]) for e in spatial],
             [e.weight for e in spatial],
         )
-        local = _LocalIndex([node.id for node in nodes], index, csr, len(levels))
+        vias: dict[tuple[int, int], NDArray[np.float64]] = {}
+        for e in spatial:
+            if e.via is not None:
+                vias[(index[e.u], index[e.v])] = e.via
+                vias[(index[e.v], index[e.u])] = e.via[::-1]
+        local = _LocalIndex([node.id for node in nodes], index, csr, len(levels), vias)
         self._local_cache[target.id] = local
         return local
 
@@ -327,7 +347,7 @@ class HierarchicalPlanner:
         query: str | None,
     ) -> RoutePlan:
         visits = [(hops[0], segments[0].tolist())]
-        chunks = [origin[None, :], network.locals[hops[0]].csr.coords[segments[0]]]
+        chunks = [origin[None, :], network.locals[hops[0]].points(segments[0])]
         target_length = 0.0
         for a, b in pairwise(hops):
             edge = network.target_edges[(a, b)]
@@ -339,7 +359,7 @@ class HierarchicalPlanner:
             chunks.append(network.locals[b].csr.coords[:1])
         if len(segments) > 1:
             visits.append((hops[-1], segments[1][1:].tolist()))
-            chunks.append(network.locals[hops[-1]].csr.coords[segments[1][1:]])
+            chunks.append(network.locals[hops[-1]].points(segments[1])[1:])
         ids: list[str] = []
         levels: list[str] = []
         poses: list[str] = []
