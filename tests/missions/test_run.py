@@ -11,8 +11,10 @@ from seminspect.core.errors import SeminspectError
 from seminspect.core.io import read_versioned_json
 from seminspect.graphs.lsg.io import load_graph
 from seminspect.graphs.lsg.model import EdgeKind
+from seminspect.mapping.voxel import load_map
 from seminspect.missions.config import make_config
 from seminspect.missions.run import run_mission
+from seminspect.missions.rundir import load_trajectory
 from seminspect.missions.xflie import XFlie
 from seminspect.planning.hierarchical import HierarchicalPlanner
 
@@ -127,3 +129,11 @@ def test_every_edge_of_the_graph_is_traversable_in_the_world(small_mission) -> N
         path = graph.edge_path(edge)
         for a, b in pairwise(path):
             assert world.segment_is_free(a, b, radius, "ground"), (edge.u, edge.v)
+
+
+def test_the_run_keeps_the_robots_final_map(small_mission, small_mission_dir: Path) -> None:
+    saved = load_map(small_mission_dir / "map.npz")
+    np.testing.assert_array_equal(saved.states, small_mission.mission.occupancy.states)
+    assert saved.counts()["occupied"] > 0
+    final = load_trajectory(small_mission_dir)[-1, 5:8]
+    np.testing.assert_allclose(final, small_mission.mission.platform.position, atol=1e-4)

@@ -275,6 +275,7 @@ def _write_outputs(
     run: RunDirectory, mission: XFlie, metrics: dict[str, Any], answers: Sequence[QueryAnswer]
 ) -> None:
     run.write_graph(mission.graph)
+    run.write_map(mission.occupancy)
     run.write_metrics(metrics)
     trajectory = mission.platform.robot.trajectory if hasattr(mission.platform, "robot") else None
     if trajectory is not None:
