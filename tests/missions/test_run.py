@@ -137,3 +137,20 @@ def test_the_run_keeps_the_robots_final_map(small_mission, small_mission_dir: Pa
     assert saved.counts()["occupied"] > 0
     final = load_trajectory(small_mission_dir)[-1, 5:8]
     np.testing.assert_allclose(final, small_mission.mission.platform.position, atol=1e-4)
+
+
+def test_the_volumetric_baseline_mission_plans_with_charged_time(tmp_path: Path) -> None:
+    config = make_config(
+        {"world": "subterranean", "scenario": None, "planner": "volumetric"}
+        | {"charge_planning_time": True}
+    )
+    result = run_mission(config, tmp_path / "baseline")
+    mission, metrics = result.mission, result.metrics
+    assert result.state == "completed" and metrics["targets"]["inspected"] >= 1
+    assert mission.volumetric is not None and not mission.hierarchical  # no graph legs
+    assert metrics["mission"]["planning_time_charged"]
+    planning = metrics["mission"]["planning_wall_s"]
+    assert planning > 0
+    assert metrics["table6"]["planning_load_pct"] == pytest.approx(
+        100 * planning / metrics["mission"]["sim_time_s"]
+    )

@@ -7,6 +7,8 @@ One mission, step by step:
 2. Target selection by utility (eq 6). Navigation: the hierarchical planner over the 3DLSG for
    the known part of the route (to the inspected target nearest the goal), then the local
    planner on the robot's own occupancy map into unknown space, to within ``ε`` of the target.
+   With ``planner="volumetric"`` (000 Sec VII-D's baseline) the volumetric planner, rebuilt on
+   the robot's map at 0.4 m for every query, plans the whole way instead.
 3. ``π^insp``: ``Level-0`` starts at the target (eq 7). At every view the pose is registered
    (eq 9) with its image, part detections go to the interim Pose-Feature graph, and FLIE's local
    view planner (002 eqs 1-2) gives the next view. A level ends when, back within
@@ -18,12 +20,17 @@ One mission, step by step:
    around the inspected target.
 5. Repeat until no uninspected target remains (then visit exploration frontiers to find more)
    or the time budget ends.
+
+Every planner call's wall time (routes, graph queries, Target-layer edges, view poses) is
+recorded; with ``charge_planning_time`` the robot also waits for it, so planning costs mission
+time as on a real robot.
 """
 
 from __future__ import annotations
 
 import itertools
 import math
+import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
@@ -57,6 +64,7 @@ from seminspect.planning.local import LocalPlanner
 from seminspect.planning.smoothing import refine_path
 from seminspect.planning.utility import UtilityTerms, select_target
 from seminspect.planning.view_planner import ViewConstraints, next_view_pose
+from seminspect.planning.volumetric import RebuildingVolumetricPlanner
 from seminspect.sensors import Detection, Frame
 
 #: Voxel size of the cloud kept of the target under inspection [m].
@@ -83,6 +91,10 @@ PLANNING_MARGIN = 0.2
 LEVEL_SWEEP_CAP = 2.0 * math.pi + math.radians(40)
 #: A part belongs to the inspected target when this share of its mask lies on the target's.
 PART_OVERLAP = 0.5
+#: The volumetric baseline's map resolution and risk band (000 Sec VII-D: D*+ on M_0.4, risk
+#: parameter 0.2) [m].
+BASELINE_RESOLUTION = 0.4
+BASELINE_RISK_RADIUS = 0.2
 
 
 @dataclass
@@ -169,9 +181,20 @@ class XFlie:
             hfov_deg=self.params.fov_deg,
             vfov_deg=platform_vfov(self.params),
         )
-        model = CostModel(config.robot.radius + PLANNING_MARGIN, risk_radius=0.3, unknown_cost=1.0)
-        band = (0.3, max(1.0, config.robot.body_height + 0.5))
+        clearance = config.robot.radius + PLANNING_MARGIN
+        model = CostModel(clearance, risk_radius=0.3, unknown_cost=1.0)
+        band = config.robot.planning_band()
         self.local = LocalPlanner(model, config.mode or "ground", band=band)
+        #: The paper's baseline planner between targets (``planner="volumetric"``).
+        self.volumetric = (
+            RebuildingVolumetricPlanner(
+                CostModel(clearance, risk_radius=BASELINE_RISK_RADIUS, unknown_cost=1.0),
+                band if config.mode == "ground" else None,
+                resolution=BASELINE_RESOLUTION,
+            )
+            if config.planner == "volumetric"
+            else None
+        )
         self.navigator = Navigator(
             platform,
             occupancy,
@@ -181,6 +204,7 @@ class XFlie:
             camera_every_m=config.exploration.camera_every_m,
             clear_misses_to=self.params.d_max,
             timers=self.timers,
+            charge_planning_time=config.charge_planning_time,
         )
         self.target_cloud = PointSet(TARGET_VOXEL)
         self.unreachable: set[str] = set()
@@ -356,7 +380,7 @@ class XFlie:
         self._event("selected", target=target.id, utility=round(target.utility, 4))
         self._hierarchical_leg(goal)
         for radius in (self.params.epsilon, self.params.epsilon + 1.0, self.params.epsilon + 2.5):
-            arrived = self.navigator.go_to(goal, radius, final_yaw=None)
+            arrived = self.navigator.go_to(goal, radius, planner=self.volumetric)
             if arrived:
                 self._event("arrived", target=target.id)
                 return True
@@ -397,7 +421,9 @@ class XFlie:
                 return  # the graph gets the robot no closer than driving straight for it
             plan = self.planner.plan(entry, here)
             self.record_plan(entry, plan)
-            route = refine_path(plan.waypoints, self.navigator.segment_is_free).waypoints
+            refined = refine_path(plan.waypoints, self.navigator.cost_grid())
+            self.navigator.planned(plan.timing.total_s + refined.refine_time)
+            route = refined.waypoints
         self.navigator.drive(route)
 
     # ----------------------------------------------------------------- inspection
@@ -591,10 +617,13 @@ class XFlie:
                 update={"overlap_h": overlap, "d_view": self.view.d_view * closer}
             )
             with self.timers("planning"):
+                started = time.perf_counter()
                 try:
                     pose = next_view_pose(self.platform.position, points, view)
                 except PlanningError:
                     return False
+                finally:
+                    self.navigator.planned(time.perf_counter() - started)
             if self._move_to_view(pose.position, pose.yaw):
                 return True
         return False
@@ -688,10 +717,13 @@ class XFlie:
         for other in inspected[:3]:
             start = LayeredSemanticGraph.entry_level(other).position
             with self.timers("planning"):
+                started = time.perf_counter()
                 try:
                     path = known.plan(self.occupancy, start, entry)
                 except PlanningError:
                     continue
+                finally:
+                    self.navigator.planned(time.perf_counter() - started)
             via = path.waypoints[1:-1]
             with self.timers("graph"):
                 self.graph.connect_targets(other.id, target.id, via if len(via) else None)
