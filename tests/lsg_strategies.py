@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from itertools import pairwise
+
 import numpy as np
 from hypothesis import strategies as st
 
@@ -44,7 +46,7 @@ def climbing_graphs(draw: st.DrawFn) -> LayeredSemanticGraph:
     for k, target in enumerate(graph.targets()):
         centre = np.array([40.0 * k, 0.0, 0.0])
         for level in range(draw(st.integers(1, 3))):
-            start = centre + [draw(coordinate), draw(coordinate), 2.0 + 3.0 * level]
+            start = centre + np.array([draw(coordinate), draw(coordinate), 2.0 + 3.0 * level])
             if level == 0:
                 graph.begin_inspection(target.id, Observation.view_pose(start))
             else:
@@ -57,6 +59,6 @@ def climbing_graphs(draw: st.DrawFn) -> LayeredSemanticGraph:
             graph.close_level(close_ring=draw(st.booleans()))
         graph.finish_inspection()
     targets = graph.targets()
-    for a, b in zip(targets, targets[1:], strict=False):
+    for a, b in pairwise(targets):
         graph.connect_targets(a.id, b.id)
     return graph

@@ -258,7 +258,7 @@ def test_maps_round_trip_and_bad_files_are_refused(tmp_path) -> None:
     np.testing.assert_allclose(loaded.origin, grid.origin)
     assert loaded.resolution == grid.resolution
     (tmp_path / "junk.npz").write_bytes(b"not a zip")
-    with pytest.raises(FileFormatError, match="junk.npz"):
+    with pytest.raises(FileFormatError, match=r"junk\.npz"):
         load_map(tmp_path / "junk.npz")
     np.savez(tmp_path / "other.npz", states=grid.states)
     with pytest.raises(FileFormatError, match="not a seminspect voxel map"):
