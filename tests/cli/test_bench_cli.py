@@ -2,19 +2,9 @@ from pathlib import Path
 
 import pytest
 
-from seminspect.cli import main
+from cli_runner import run
 from seminspect.missions import planning_study
 from study_fakes import study
-
-
-def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
-    try:
-        main(list(args))
-        code = 0
-    except SystemExit as exit_:
-        code = int(exit_.code or 0)
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
 
 
 def test_the_planning_study_writes_its_tables_figure_and_json(capsys, tmp_path, monkeypatch):

@@ -103,7 +103,7 @@ def test_only_a_complete_run_of_the_same_configuration_is_reused(tmp_path, monke
     stray = tmp_path / "city-small-seed0-volumetric-charged"
     stray.mkdir()
     with pytest.raises(InvalidInputError, match="not a run directory"):
-        ensure_run(study_config("small", "volumetric", charged=True), tmp_path)
+        ensure_run(study_config("small", "volumetric", table6=True), tmp_path)
 
 
 def test_an_unfinished_study_run_is_run_again(tmp_path, monkeypatch) -> None:
@@ -115,7 +115,10 @@ def test_an_unfinished_study_run_is_run_again(tmp_path, monkeypatch) -> None:
     assert calls == [stale] and not (stale / "images").exists()
 
 
-def test_bad_scenarios_are_named() -> None:
+def test_table_6_runs_charge_planning_under_the_papers_budget() -> None:
+    assert study_config("large").time_budget_s == 3600.0  # the mission default
+    table6 = study_config("large", "volumetric", table6=True)
+    assert table6.time_budget_s == 2800.0 and table6.charge_planning_time
     with pytest.raises(InvalidInputError, match="unknown city scenario 'huge'"):
         study_config("huge")
 
