@@ -282,6 +282,9 @@ class RunComparison:
     graph_nodes: int
     inspected_targets: int
     map_build_s: dict[float, float]
+    #: Calls per query whose median is reported: hierarchical (and refinement), volumetric.
+    repeats: int
+    vp_repeats: int
     queries: list[QueryComparison] = field(default_factory=list)
 
 
@@ -363,6 +366,8 @@ def compare_run(
         graph_nodes=stats.unified.nodes,
         inspected_targets=stats.targets_inspected,
         map_build_s=build,
+        repeats=repeats,
+        vp_repeats=vp_repeats,
         queries=comparisons,
     )
 

@@ -235,12 +235,11 @@ def beside_paper(runs: Sequence[RunComparison]) -> list[str]:
         "|---" * (1 + 2 * len(columns)) + "|",
     ]
 
-    def row(name: str, key: str, fmt, stat: str = "median", paper_key: str | None = None):
+    def row(name: str, key: str, fmt, stat: str = "median") -> None:
         cells = []
         for s in columns:
-            paper = papers[s].get(paper_key or key)
             cells.append(fmt(ours[s][key][stat]))
-            cells.append(fmt(paper[stat]) if paper else "-")
+            cells.append(fmt(papers[s][key][stat]) if key in papers[s] else "-")
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
 
     row("HP Target-layer search (µs)", "hp_target_layer_s", _us)
@@ -251,12 +250,13 @@ def beside_paper(runs: Sequence[RunComparison]) -> list[str]:
     row("VP at 0.7 m (ms)", "vp_0.7_s", _ms)
     row("VP/HP time at 0.5 m, searches", "time_ratio_0.5_search", _ratio)
     row("VP/HP time at 0.5 m, searches (min)", "time_ratio_0.5_search", _ratio, "min")
-    row("VP/HP time at 0.5 m, end to end", "time_ratio_0.5_query", _ratio, paper_key="-")
+    row("VP/HP time at 0.5 m, end to end", "time_ratio_0.5_query", _ratio)
+    row("VP/HP time at 0.5 m, end to end (min)", "time_ratio_0.5_query", _ratio, "min")
     row("VP/HP time at 0.7 m, searches", "time_ratio_0.7_search", _ratio)
     row("HP/VP length at 0.5 m (mean)", "length_ratio_0.5", _num, "mean")
     row("HP/VP length at 0.7 m (mean)", "length_ratio_0.7", _num, "mean")
-    row("refined HP/VP length at 0.5 m (mean)", "refined_length_ratio_0.5", _num, "mean", "-")
-    row("VP/(HP + refinement) time at 0.5 m", "time_ratio_0.5_refined", _ratio, paper_key="-")
+    row("refined HP/VP length at 0.5 m (mean)", "refined_length_ratio_0.5", _num, "mean")
+    row("VP/(HP end to end + refinement) time at 0.5 m", "time_ratio_0.5_refined", _ratio)
     return lines
 
 
@@ -269,6 +269,7 @@ def table5_markdown(runs: Sequence[RunComparison]) -> str:
             f"### City {run.scenario} (scenario {number})",
             "",
             f"Run `{run.run_dir}`: {run.inspected_targets} inspected targets, "
+            f"times are medians of {run.repeats} calls (HP, refinement) and {run.vp_repeats} (VP), "
             f"{run.graph_nodes} graph nodes; start (robot's final pose) "
             f"{np.round(run.start, 2).tolist()}. Volumetric maps built once in "
             + ", ".join(f"{1e3 * s:.0f} ms ({r:g} m)" for r, s in run.map_build_s.items())
@@ -357,9 +358,9 @@ def targets_markdown(met: dict[str, Any]) -> str:
 def study_markdown(study: PlanningStudy) -> str:
     parts = ["# Planning study: hierarchical (3DLSG) versus volumetric planning", ""]
     parts.append(
-        "Times are medians over repeats on this machine (HP: 200 calls per query, VP: 3); "
-        f"{machine_line()}. HP = hierarchical planner, VP = volumetric baseline (A*, ground "
-        "band, robot radius 0.4 m, risk band 0.2 m); paper numbers are 000's.\n"
+        f"Measured on this machine ({machine_line()}). HP = hierarchical planner, VP = "
+        "volumetric baseline (A*, ground band, robot radius 0.4 m, risk band 0.2 m); paper "
+        "numbers are 000's.\n"
     )
     parts.append(targets_markdown(targets_met(study)))
     if study.table5:
@@ -434,6 +435,7 @@ def study_document(study: PlanningStudy) -> dict[str, Any]:
             {
                 "scenario": run.scenario,
                 "run_dir": str(run.run_dir),
+                "repeats": {"hierarchical": run.repeats, "volumetric": run.vp_repeats},
                 "start": run.start.tolist(),
                 "graph_nodes": run.graph_nodes,
                 "inspected_targets": run.inspected_targets,
