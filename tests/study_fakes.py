@@ -35,7 +35,8 @@ def query(vp_s: float, hp_m: float = 110.0, refined_m: float = 100.0) -> QueryCo
 def study(vp_s: float = 0.03) -> PlanningStudy:
     run = RunComparison(
         "large", Path("runs/large"), np.array([1.0, 2.0, 0.7]), 1000, 20,
-        {r: 0.01 for r in RESOLUTIONS}, 200, 3, [query(vp_s), query(2 * vp_s, refined_m=120.0)],
+        {r: 0.01 for r in RESOLUTIONS}, PathCheck(40, 41), 200, 3,
+        [query(vp_s), query(2 * vp_s, refined_m=120.0)],
     )  # fmt: skip
     points = [
         ScalingPoint(n, 50 * n, 100 * n, 1e4 * n, 1e4 * n, 3, 5e-6 * n**0.3, 6e-6 * n**0.3,

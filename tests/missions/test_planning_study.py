@@ -126,6 +126,7 @@ def test_table_6_runs_charge_planning_under_the_papers_budget() -> None:
 def test_a_run_is_compared_query_by_query(small_mission_dir: Path) -> None:
     result = compare_run(small_mission_dir, count=3, repeats=3, vp_repeats=1, resolutions=(0.5,))
     assert len(result.queries) == 3 and result.inspected_targets >= 3
+    assert result.edge_check.all_valid and result.edge_check.segments > 40
     np.testing.assert_allclose(result.start, planning_study.final_pose(small_mission_dir))
     for q in result.queries:
         assert q.hp_check.all_valid and q.refined_check.all_valid

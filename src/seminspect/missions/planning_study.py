@@ -34,7 +34,7 @@ from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.core.io import read_versioned_json
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.io import load_graph
-from seminspect.graphs.lsg.model import FeatureNode, TargetNode, TargetStatus
+from seminspect.graphs.lsg.model import EdgeKind, FeatureNode, TargetNode, TargetStatus
 from seminspect.mapping.voxel import VoxelMap, load_map
 from seminspect.missions.config import CITY_BUDGETS, MissionConfig, make_config, resolve
 from seminspect.missions.run import run_mission, run_name
@@ -282,6 +282,8 @@ class RunComparison:
     graph_nodes: int
     inspected_targets: int
     map_build_s: dict[float, float]
+    #: Segments of every spatial edge of the graph that are free in the world.
+    edge_check: PathCheck
     #: Calls per query whose median is reported: hierarchical (and refinement), volumetric.
     repeats: int
     vp_repeats: int
@@ -299,6 +301,16 @@ class _Setting:
     #: The robot's final map as its planners see it (clearance with the mission's margin).
     robot_grid: CostGrid
     planners: dict[float, VolumetricPlanner]
+
+
+def graph_edge_check(graph: LayeredSemanticGraph, world: World, radius: float) -> PathCheck:
+    """Segments of the polylines of every spatial edge of the graph, checked in the world."""
+    checks = [
+        PathCheck.of(world, graph.edge_path(e), radius)
+        for e in graph.edges()
+        if e.kind is EdgeKind.SPATIAL
+    ]
+    return PathCheck(sum(c.valid for c in checks), sum(c.segments for c in checks))
 
 
 def final_pose(run_dir: Path) -> NDArray[np.float64]:
@@ -366,6 +378,7 @@ def compare_run(
         graph_nodes=stats.unified.nodes,
         inspected_targets=stats.targets_inspected,
         map_build_s=build,
+        edge_check=graph_edge_check(setting.graph, setting.world, setting.radius),
         repeats=repeats,
         vp_repeats=vp_repeats,
         queries=comparisons,

@@ -273,7 +273,8 @@ def table5_markdown(runs: Sequence[RunComparison]) -> str:
             f"{run.graph_nodes} graph nodes; start (robot's final pose) "
             f"{np.round(run.start, 2).tolist()}. Volumetric maps built once in "
             + ", ".join(f"{1e3 * s:.0f} ms ({r:g} m)" for r, s in run.map_build_s.items())
-            + ". Valid segments (true world, robot radius): HP "
+            + ". Valid segments (true world, robot radius): graph edges "
+            f"{_pct(dataclasses.asdict(run.edge_check))}, HP paths "
             f"{_pct(summary['hp_valid_segments'])}, refined "
             f"{_pct(summary['refined_valid_segments'])}, VP 0.5 m "
             f"{_pct(summary['vp_0.5_valid_segments'])}.",
@@ -436,6 +437,7 @@ def study_document(study: PlanningStudy) -> dict[str, Any]:
                 "scenario": run.scenario,
                 "run_dir": str(run.run_dir),
                 "repeats": {"hierarchical": run.repeats, "volumetric": run.vp_repeats},
+                "graph_edge_check": dataclasses.asdict(run.edge_check),
                 "start": run.start.tolist(),
                 "graph_nodes": run.graph_nodes,
                 "inspected_targets": run.inspected_targets,
