@@ -701,7 +701,12 @@ class XFlie:
         return np.array(chain)
 
     def _connect_inspected(self, target: TargetNode) -> None:
-        """``v_I - v_I`` edges to the nearest inspected targets, through known free space."""
+        """``v_I - v_I`` edges to the nearest inspected targets, through known free space.
+
+        The robot does not drive these routes now, so they keep half a cell diagonal more
+        clearance than its routes: the planner measures between cell centres, and a straight
+        segment may pass anywhere within the cells it crosses.
+        """
         inspected = [t for t in self.graph.targets(TargetStatus.INSPECTED) if t is not target]
         entry = LayeredSemanticGraph.entry_level(target).position
         inspected.sort(
@@ -709,8 +714,10 @@ class XFlie:
                 np.linalg.norm(LayeredSemanticGraph.entry_level(t).position - entry)
             )
         )
+        dims = 2 if self.local.mode == "ground" else 3
+        slack = 0.5 * self.occupancy.resolution * math.sqrt(dims)
         known = LocalPlanner(
-            CostModel(self.local.model.robot_radius, risk_radius=0.0, unknown_cost=None),
+            CostModel(self.local.model.robot_radius + slack, risk_radius=0.0, unknown_cost=None),
             self.local.mode,
             band=self.local.band or (0.3, 1.5),
         )
