@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from seminspect.core.errors import InvalidInputError
+from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.synthetic import synthetic_graph
 from seminspect.mapping.voxel import VoxelMap, save_map
 from seminspect.missions import planning_study
@@ -17,11 +18,13 @@ from seminspect.missions.planning_study import (
     above_ground,
     compare_run,
     ensure_run,
+    reachable_targets,
     reusable_run,
     select_queries,
     study_config,
 )
 from seminspect.missions.rundir import RunDirectory
+from seminspect.perception.observation import Observation
 from seminspect.planning.comparison import HierarchicalTiming, VolumetricResult
 from seminspect.planning.hierarchical import HierarchicalPlanner
 
@@ -142,3 +145,22 @@ def test_mission_outcomes_are_read_from_the_metrics(small_mission_dir: Path) -> 
     assert outcome.planning_load_pct == pytest.approx(
         100 * outcome.planning_wall_s / outcome.sim_time_s
     )
+
+
+def test_queries_keep_to_targets_the_graph_joins_to_the_start() -> None:
+    graph = LayeredSemanticGraph()
+    for x in (0.0, 60.0):  # two cars, inspected, never joined in the Target layer
+        graph.register_target(Observation([x, 0, 0.7], label="car", mask_area=1))
+    graph.optimise_targets()
+    for target, x in zip(graph.targets(), (0.0, 60.0), strict=True):
+        graph.begin_inspection(target.id, Observation.view_pose([x - 3, 0, 0.7]))
+        for dx, dy in ((0, 3), (3, 0), (0, -3)):
+            graph.register_pose(Observation.view_pose([x + dx, dy, 0.7]))
+            graph.register_feature(Observation([x + dx / 2, dy / 2, 0.7], label="hood"))
+        graph.finish_inspection()
+    planner = HierarchicalPlanner(graph)
+    start = np.array([-5.0, 0.0, 0.7])
+    assert reachable_targets(planner, start) == {"car-0"}
+    queries = select_queries(graph, start, 4, reachable={"car-0"})
+    assert queries and all(q.endswith("of car-0") for q in queries)
+    assert any(q.endswith("of car-1") for q in select_queries(graph, start, 4))

@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 import shutil
 import statistics
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from seminspect.core.errors import FileFormatError, InvalidInputError
+from seminspect.core.errors import FileFormatError, InvalidInputError, PlanningError
 from seminspect.core.io import read_versioned_json
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.io import load_graph
@@ -166,9 +166,15 @@ def reusable_run(run_dir: Path, config: MissionConfig) -> bool:
 
 
 # ---------------------------------------------------------------------------- queries
-def select_queries(graph: LayeredSemanticGraph, start: ArrayLike, count: int = 9) -> list[str]:
+def select_queries(
+    graph: LayeredSemanticGraph,
+    start: ArrayLike,
+    count: int = 9,
+    reachable: Collection[str] | None = None,
+) -> list[str]:
     """``count`` operator queries ("Visit <feature> in <level> of <target>") spread from the
-    nearest to the farthest inspected target (by distance from ``start``).
+    nearest to the farthest inspected target (by distance from ``start``), among the
+    ``reachable`` targets when given.
 
     Targets are taken at evenly spaced ranks of distance; with fewer targets than queries each
     target is asked for again, for its next feature. A target's features are taken first ones
@@ -178,7 +184,11 @@ def select_queries(graph: LayeredSemanticGraph, start: ArrayLike, count: int = 9
     if not (isinstance(count, int) and count >= 1):
         raise InvalidInputError(f"query count must be a positive integer, got {count!r}")
     origin = np.asarray(start, dtype=np.float64)
-    targets = [t for t in graph.targets(TargetStatus.INSPECTED) if _features(t)]
+    targets = [
+        t
+        for t in graph.targets(TargetStatus.INSPECTED)
+        if _features(t) and (reachable is None or t.id in reachable)
+    ]
     if not targets:
         raise InvalidInputError("the graph has no inspected target with features to query")
     targets.sort(key=lambda t: (float(np.linalg.norm(t.position - origin)), t.id))
@@ -303,6 +313,19 @@ class _Setting:
     planners: dict[float, VolumetricPlanner]
 
 
+def reachable_targets(planner: HierarchicalPlanner, start: NDArray[np.float64]) -> set[str]:
+    """Inspected targets the graph joins to where the robot is (the Target layer may be split
+    where no route through known free space was found between inspected targets)."""
+    found = set()
+    for target in planner.graph.targets(TargetStatus.INSPECTED):
+        try:
+            planner.plan(target.id, start)
+        except PlanningError:
+            continue
+        found.add(target.id)
+    return found
+
+
 def graph_edge_check(graph: LayeredSemanticGraph, world: World, radius: float) -> PathCheck:
     """Segments of the polylines of every spatial edge of the graph, checked in the world."""
     checks = [
@@ -364,8 +387,9 @@ def compare_run(
     setting, build = _setting(root, resolutions)
     planner = HierarchicalPlanner(setting.graph)
     refine_path(setting.graph.robot.position[None].repeat(2, 0), setting.robot_grid)  # warm up
+    reachable = reachable_targets(planner, setting.start)
     comparisons = []
-    for text in select_queries(setting.graph, setting.start, count):
+    for text in select_queries(setting.graph, setting.start, count, reachable):
         comparisons.append(_compare(setting, planner, text, repeats, vp_repeats))
         if progress is not None:
             progress(text)

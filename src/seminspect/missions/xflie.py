@@ -58,6 +58,7 @@ from seminspect.perception.similarity import (
     SceneMatcher,
     scene_similarity,
 )
+from seminspect.planning.grid_search import GridPath
 from seminspect.planning.gridmap import CostModel
 from seminspect.planning.hierarchical import HierarchicalPlanner, RoutePlan
 from seminspect.planning.local import LocalPlanner
@@ -419,7 +420,10 @@ class XFlie:
                 (goal - here)[:2]
             ):
                 return  # the graph gets the robot no closer than driving straight for it
-            plan = self.planner.plan(entry, here)
+            try:
+                plan = self.planner.plan(entry, here)
+            except PlanningError:  # the Target layer does not join the two; drive without it
+                return
             self.record_plan(entry, plan)
             refined = refine_path(plan.waypoints, self.navigator.cost_grid())
             self.navigator.planned(plan.timing.total_s + refined.refine_time)
@@ -704,8 +708,9 @@ class XFlie:
         """``v_I - v_I`` edges to the nearest inspected targets, through known free space.
 
         The robot does not drive these routes now, so they keep half a cell diagonal more
-        clearance than its routes: the planner measures between cell centres, and a straight
-        segment may pass anywhere within the cells it crosses.
+        clearance than its routes where they can: the planner measures between cell centres,
+        and a straight segment may pass anywhere within the cells it crosses. Where no route
+        keeps it, the robot's own clearance is used, so the Target layer stays as connected.
         """
         inspected = [t for t in self.graph.targets(TargetStatus.INSPECTED) if t is not target]
         entry = LayeredSemanticGraph.entry_level(target).position
@@ -716,21 +721,22 @@ class XFlie:
         )
         dims = 2 if self.local.mode == "ground" else 3
         slack = 0.5 * self.occupancy.resolution * math.sqrt(dims)
-        known = LocalPlanner(
-            CostModel(self.local.model.robot_radius + slack, risk_radius=0.0, unknown_cost=None),
-            self.local.mode,
-            band=self.local.band or (0.3, 1.5),
-        )
+        planners = [
+            LocalPlanner(
+                CostModel(self.local.model.robot_radius + extra, 0.0, unknown_cost=None),
+                self.local.mode,
+                band=self.local.band or (0.3, 1.5),
+            )
+            for extra in (slack, 0.0)
+        ]
         for other in inspected[:3]:
             start = LayeredSemanticGraph.entry_level(other).position
             with self.timers("planning"):
                 started = time.perf_counter()
-                try:
-                    path = known.plan(self.occupancy, start, entry)
-                except PlanningError:
-                    continue
-                finally:
-                    self.navigator.planned(time.perf_counter() - started)
+                path = _first_route(planners, self.occupancy, start, entry)
+                self.navigator.planned(time.perf_counter() - started)
+            if path is None:
+                continue
             via = path.waypoints[1:-1]
             with self.timers("graph"):
                 self.graph.connect_targets(other.id, target.id, via if len(via) else None)
@@ -765,6 +771,21 @@ class XFlie:
                     for t in terms
                 },
             )
+
+
+def _first_route(
+    planners: Iterable[LocalPlanner],
+    occupancy: VoxelMap,
+    start: NDArray[np.float64],
+    goal: NDArray[np.float64],
+) -> GridPath | None:
+    """The route of the first planner that finds one, if any."""
+    for planner in planners:
+        try:
+            return planner.plan(occupancy, start, goal)
+        except PlanningError:
+            continue
+    return None
 
 
 class PointSet:
