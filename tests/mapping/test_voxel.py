@@ -5,9 +5,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from seminspect.core.errors import InvalidInputError
+from seminspect.core.errors import FileFormatError, InvalidInputError
+from seminspect.core.io import save_npz_atomic
 from seminspect.geometry.transforms import quat_from_yaw
-from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap
+from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap, load_map, save_map
 from seminspect.sensors import CameraModel, Lidar, render
 from sim_worlds import box_world
 
@@ -208,3 +209,67 @@ def test_lidar_misses_clear_free_space_only_when_asked() -> None:
     assert plain.state_at([above])[0] == UNKNOWN and cleared.state_at([above])[0] == FREE
     with pytest.raises(InvalidInputError, match="clear_misses_to"):
         cleared.integrate_scan(scan, clear_misses_to=50.0)
+
+
+def test_boxes_occupy_the_cells_they_overlap() -> None:
+    grid = VoxelMap.from_boxes([0, 0, 0], [4, 4, 2], 0.5, [[[1.2, 1.2, 0.0], [2.0, 1.4, 0.8]]])
+    occupied = np.argwhere(grid.states == OCCUPIED)
+    assert {tuple(c) for c in occupied} == {(i, 2, k) for i in (2, 3) for k in (0, 1)}
+    assert grid.counts()["unknown"] == 0
+    with pytest.raises(InvalidInputError, match="finite"):
+        VoxelMap.from_boxes([0, 0, 0], [4, 4, 2], 0.5, [[[0, 0, 0], [1, 1, float("inf")]]])
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    st.integers(0, 2**16),
+    st.sampled_from([(0.2, 0.5), (0.3, 0.4), (0.3, 0.7), (0.25, 0.25)]),
+)
+def test_coarsening_keeps_every_obstacle_and_invents_none(seed, resolutions) -> None:
+    fine_res, coarse_res = resolutions
+    rng = np.random.default_rng(seed)
+    fine = VoxelMap.empty([-1.0, 0.5, 0.0], [3.1, 4.0, 1.9], fine_res)
+    fine.states[:] = rng.choice([UNKNOWN, FREE, OCCUPIED], size=fine.shape, p=[0.3, 0.65, 0.05])
+    coarse = fine.coarsened(coarse_res)
+    np.testing.assert_allclose(coarse.origin, fine.origin)
+    assert np.all(coarse.upper >= fine.upper - 1e-9)
+    centres = fine.index_to_world(np.argwhere(np.ones(fine.shape, bool)))
+    # every fine cell's centre lies in a coarse cell of at least its state
+    held = coarse.state_at(centres).reshape(fine.shape)
+    assert np.all(held >= fine.states)
+    # a coarse cell is occupied only when an occupied fine cell overlaps it
+    for cell in np.argwhere(coarse.states == OCCUPIED):
+        lo = coarse.origin + cell * coarse_res
+        hi = lo + coarse_res
+        f_lo = np.floor((lo - fine.origin) / fine_res + 1e-9).astype(int)
+        f_hi = np.ceil((hi - fine.origin) / fine_res - 1e-9).astype(int)
+        block = fine.states[f_lo[0] : f_hi[0], f_lo[1] : f_hi[1], f_lo[2] : f_hi[2]]
+        assert (block == OCCUPIED).any()
+    with pytest.raises(InvalidInputError, match="coarser"):
+        fine.coarsened(fine_res / 2)
+
+
+def test_maps_round_trip_and_bad_files_are_refused(tmp_path) -> None:
+    grid = VoxelMap.empty([0, 0, -0.1], [2, 1, 1], 0.25)
+    grid.states[1, 2, 3] = OCCUPIED
+    grid.states[0] = FREE
+    loaded = load_map(save_map(tmp_path / "map.npz", grid))
+    np.testing.assert_array_equal(loaded.states, grid.states)
+    np.testing.assert_allclose(loaded.origin, grid.origin)
+    assert loaded.resolution == grid.resolution
+    (tmp_path / "junk.npz").write_bytes(b"not a zip")
+    with pytest.raises(FileFormatError, match=r"junk\.npz"):
+        load_map(tmp_path / "junk.npz")
+    np.savez(tmp_path / "other.npz", states=grid.states)
+    with pytest.raises(FileFormatError, match="not a seminspect voxel map"):
+        load_map(tmp_path / "other.npz")
+    save_npz_atomic(
+        tmp_path / "bad.npz",
+        format=np.array("seminspect.voxel-map"),
+        version=np.array(1),
+        origin=grid.origin,
+        resolution=np.array(0.25),
+        states=np.full((2, 2, 2), 7, np.uint8),
+    )
+    with pytest.raises(FileFormatError, match="0, 1, 2"):
+        load_map(tmp_path / "bad.npz")

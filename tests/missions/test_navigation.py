@@ -1,5 +1,10 @@
+import numpy as np
+import pytest
+
 from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap
-from seminspect.missions.navigation import find_frontiers
+from seminspect.missions.navigation import Navigator, find_frontiers
+from seminspect.planning.gridmap import CostModel
+from seminspect.planning.local import LocalPlanner
 
 
 def corridor_map() -> VoxelMap:
@@ -24,3 +29,33 @@ def test_no_frontier_in_a_fully_known_map() -> None:
     grid = corridor_map()
     grid.states[grid.states == UNKNOWN] = FREE
     assert find_frontiers(grid, (0.3, 1.5), min_cells=1, height=0.7) == []
+
+
+class _WaitingPlatform:
+    """Just enough of a platform to see what the navigator charges to the clock."""
+
+    def __init__(self) -> None:
+        self.time = 0.0
+        self.position = np.array([1.0, 1.0, 0.7])
+
+    def wait(self, seconds: float) -> None:
+        self.time += seconds
+
+
+@pytest.mark.parametrize("charged", [False, True])
+def test_planning_time_is_charged_to_the_clock_only_when_asked(charged) -> None:
+    platform = _WaitingPlatform()
+    navigator = Navigator(
+        platform,  # type: ignore[arg-type]
+        corridor_map(),
+        LocalPlanner(CostModel(0.4), mode="ground", band=(0.3, 1.5)),
+        on_frame=lambda frame: None,
+        lidar_every_m=2.0,
+        camera_every_m=4.0,
+        clear_misses_to=10.0,
+        charge_planning_time=charged,
+    )
+    navigator.planned(0.25)
+    navigator.planned(0.5)
+    assert navigator.stats.planning_s == pytest.approx(0.75)
+    assert platform.time == pytest.approx(0.75 if charged else 0.0)

@@ -1,6 +1,7 @@
 """End to end: a small mission, its run directory, interruption and failure."""
 
 import json
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -9,8 +10,11 @@ import pytest
 from seminspect.core.errors import SeminspectError
 from seminspect.core.io import read_versioned_json
 from seminspect.graphs.lsg.io import load_graph
+from seminspect.graphs.lsg.model import EdgeKind
+from seminspect.mapping.voxel import load_map
 from seminspect.missions.config import make_config
 from seminspect.missions.run import run_mission
+from seminspect.missions.rundir import load_trajectory
 from seminspect.missions.xflie import XFlie
 from seminspect.planning.hierarchical import HierarchicalPlanner
 
@@ -114,3 +118,39 @@ def test_a_failure_mid_mission_is_recorded_and_reported(tmp_path: Path, monkeypa
     status = read_versioned_json(tmp_path / "run" / "status.json", "seminspect.run-status", [1])
     assert status["state"] == "failed" and "camera unplugged" in status["reason"]
     assert load_graph(tmp_path / "run" / "graph.json").targets()  # what was found survives
+
+
+def test_every_edge_of_the_graph_is_traversable_in_the_world(small_mission) -> None:
+    graph, world = small_mission.mission.graph, small_mission.world
+    radius = small_mission.mission.config.robot.radius
+    spatial = [e for e in graph.edges() if e.kind is EdgeKind.SPATIAL]
+    assert len(spatial) > 40
+    for edge in spatial:
+        path = graph.edge_path(edge)
+        for a, b in pairwise(path):
+            assert world.segment_is_free(a, b, radius, "ground"), (edge.u, edge.v)
+
+
+def test_the_run_keeps_the_robots_final_map(small_mission, small_mission_dir: Path) -> None:
+    saved = load_map(small_mission_dir / "map.npz")
+    np.testing.assert_array_equal(saved.states, small_mission.mission.occupancy.states)
+    assert saved.counts()["occupied"] > 0
+    final = load_trajectory(small_mission_dir)[-1, 5:8]
+    np.testing.assert_allclose(final, small_mission.mission.platform.position, atol=1e-4)
+
+
+def test_the_volumetric_baseline_mission_plans_with_charged_time(tmp_path: Path) -> None:
+    config = make_config(
+        {"world": "subterranean", "scenario": None, "planner": "volumetric"}
+        | {"charge_planning_time": True}
+    )
+    result = run_mission(config, tmp_path / "baseline")
+    mission, metrics = result.mission, result.metrics
+    assert result.state == "completed" and metrics["targets"]["inspected"] >= 1
+    assert mission.volumetric is not None and not mission.hierarchical  # no graph legs
+    assert metrics["mission"]["planning_time_charged"]
+    planning = metrics["mission"]["planning_wall_s"]
+    assert planning > 0
+    assert metrics["table6"]["planning_load_pct"] == pytest.approx(
+        100 * planning / metrics["mission"]["sim_time_s"]
+    )

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from lsg_strategies import layered_graphs
+from lsg_strategies import climbing_graphs, layered_graphs
 from seminspect.core.errors import PlanningError
 from seminspect.geometry.transforms import yaw_from_quat
 from seminspect.graphs.lsg.convert import traversable_networkx
@@ -112,3 +112,42 @@ def test_unplannable_requests_say_why() -> None:
         HierarchicalPlanner(synthetic_graph(1)).plan("robot")
     with pytest.raises(PlanningError, match="no inspected targets"):
         HierarchicalPlanner(graph).localise([0, 0, 0])
+
+
+@settings(max_examples=40, deadline=None)
+@given(climbing_graphs(), st.data())
+def test_routes_follow_realised_level_edges_and_skip_open_rings(graph, data) -> None:
+    flat = traversable_networkx(graph)
+    planner = HierarchicalPlanner(graph)
+    start = np.array(data.draw(st.tuples(*[st.floats(-30, 120)] * 3)))
+    goal = data.draw(st.sampled_from([n.id for n in graph.nodes() if isinstance(n, PoseNode)]))
+    plan = planner.plan(goal, start)
+    assert plan.cost == pytest.approx(nx.dijkstra_path_length(flat, plan.node_path[0], goal))
+    # the metric path holds every via point: its length is the graph cost plus the first leg
+    first_leg = np.linalg.norm(plan.waypoints[1] - start)
+    assert plan.length == pytest.approx(first_leg + plan.cost, rel=1e-9, abs=1e-9)
+    for a, b in pairwise(plan.node_path):
+        assert a == b or flat.has_edge(a, b), (a, b)
+
+
+def test_a_level_edge_is_driven_through_its_via_points() -> None:
+    graph = LayeredSemanticGraph()
+    graph.register_target(Observation([5, 0, 1], label="building", score=1, mask_area=1))
+    graph.optimise_targets()
+    graph.begin_inspection("building-0", Observation.view_pose([0, 0, 1]))
+    graph.register_pose(Observation.view_pose([0, 4, 1]))
+    graph.register_pose(Observation.view_pose([4, 4, 1]))
+    graph.close_level(close_ring=False)
+    graph.begin_level(Observation.view_pose([4, 4, 4]), via=[[0, 4, 1], [4, 4, 1]])
+    graph.register_pose(Observation.view_pose([6, 4, 4]))
+    graph.finish_inspection()
+    plan = HierarchicalPlanner(graph).plan("building-0/Level-1/pose-0", [0, 0, 1])
+    assert plan.node_path == (
+        "building-0/Level-0",
+        "building-0/Level-1",
+        "building-0/Level-1/pose-0",
+    )
+    np.testing.assert_allclose(
+        plan.waypoints, [[0, 0, 1], [0, 0, 1], [0, 4, 1], [4, 4, 1], [4, 4, 4], [6, 4, 4]]
+    )
+    assert graph.edge("building-0/Level-0/pose-1", "building-0/Level-0") is None  # ring open

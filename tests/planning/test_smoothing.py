@@ -6,7 +6,7 @@ from scipy.spatial.distance import cdist
 
 from seminspect.core.errors import InvalidInputError, PlanningError
 from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap
-from seminspect.planning.gridmap import CostModel
+from seminspect.planning.gridmap import CostGrid, CostModel
 from seminspect.planning.smoothing import (
     path_length,
     refine_path,
@@ -107,3 +107,16 @@ def test_voxel_checker_respects_clearance_and_unknown() -> None:
     assert voxel_segment_checker(grid_map, 0.0, unknown_is_free=True)(c, d)
     with pytest.raises(InvalidInputError, match="clearance"):
         voxel_segment_checker(grid_map, -1.0)
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 10_000), st.booleans())
+def test_the_compiled_shortcut_on_a_grid_matches_the_generic_one(seed, lazy) -> None:
+    grid_map = _obstacle_field(seed)
+    grid = CostGrid.build(grid_map, CostModel(0.3, risk_weight=0.0), lazy=lazy)
+    rng = np.random.default_rng(seed)
+    path = rng.uniform([-1, -1, 0.2], [13, 13, 2.8], (12, 3))  # some ends lie off the map
+    generic = refine_path(path, CostGrid.build(grid_map, grid.model).segment_is_free)
+    compiled = refine_path(path, grid)
+    np.testing.assert_array_equal(compiled.waypoints, generic.waypoints)
+    assert compiled.refined_length == pytest.approx(generic.refined_length)

@@ -12,7 +12,7 @@ from seminspect.core.errors import InvalidInputError, PlanningError, UnknownName
 from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap
 from seminspect.planning.grid_search import make_query
 from seminspect.planning.gridmap import CostModel
-from seminspect.planning.volumetric import ENGINES, VolumetricPlanner
+from seminspect.planning.volumetric import ENGINES, RebuildingVolumetricPlanner, VolumetricPlanner
 
 
 def _reference_graph(planner: VolumetricPlanner) -> nx.Graph:
@@ -230,3 +230,34 @@ def test_plans_across_the_real_geb079_corridor(shared_data) -> None:
     assert cdist(grid_map.index_to_world(path.cells), occupied).min() >= 0.25
     straight = float(np.linalg.norm(goal - start))
     assert straight <= path.length <= 1.15 * straight
+
+
+def test_a_blocked_start_escapes_within_the_tolerance() -> None:
+    grid = VoxelMap.empty([0, 0, 0], [10, 4, 1], 0.5)
+    grid.states[:] = FREE
+    grid.states[4, :4, :] = OCCUPIED  # a wall at x = 2..2.5 m, open above y = 2 m
+    planner = VolumetricPlanner(grid, CostModel(0.6, risk_weight=0.0), band=(0.0, 1.0))
+    start = [2.9, 0.5, 0.5]  # 0.4 m from the wall's cell centres: inside the inflation
+    with pytest.raises(PlanningError, match="start"):
+        planner.plan(start, [9.0, 1.0, 0.5])
+    path = planner.plan(start, [9.0, 1.0, 0.5], start_tolerance=1.0)
+    np.testing.assert_allclose(path.waypoints[0], start)
+    assert np.isfinite(planner.grid.costs_of(path.cells[0]))
+
+
+def test_the_mission_baseline_rebuilds_a_coarse_grid_and_shortcuts_it() -> None:
+    fine = VoxelMap.empty([0, 0, 0], [12, 8, 1.2], 0.3)
+    fine.states[:] = FREE
+    fine.states[15:18, 0:20, :] = OCCUPIED  # a wall at x = 4.5..5.4 m up to y = 6 m
+    fine.states[30:, :, :] = UNKNOWN
+    model = CostModel(0.4, unknown_cost=1.0)
+    baseline = RebuildingVolumetricPlanner(model, band=(0.3, 1.0), resolution=0.4)
+    path = baseline.plan(fine, [1.0, 1.0, 0.7], [11.0, 1.0, 0.7], goal_radius=0.5)
+    reference = VolumetricPlanner(fine.coarsened(0.4), model, band=(0.3, 1.0))
+    raw = reference.plan([1.0, 1.0, 0.7], [11.0, 1.0, 0.7], goal_radius=0.5)
+    assert path.cost == pytest.approx(raw.cost)  # the same optimal search on the coarse map
+    assert path.length <= raw.length + 1e-9 and len(path.waypoints) < len(raw.waypoints)
+    assert path.waypoints[:, 1].max() > 6.0  # around the end of the wall
+    for a, b in itertools.pairwise(path.waypoints):
+        assert reference.grid.segment_is_free(a, b)
+    assert path.planning_time > 0 and path.engine == "volumetric-rebuilt"

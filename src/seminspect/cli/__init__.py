@@ -30,6 +30,7 @@ GROUPS: tuple[tuple[str, str, str], ...] = (
     ("graph", "graph", "Inspect, query and export 3D Layered Semantic Graphs."),
     ("terrain", "terrain", "Terrain-aware, task-driven outdoor scene graphs (paper 001)."),
     ("world", "world", "List, draw and export the built-in simulated worlds."),
+    ("bench", "bench", "Studies that reproduce the papers' comparisons (planning: 000 Table 5)."),
 )
 
 app = typer.Typer(

@@ -13,16 +13,20 @@ of resolution r_V whose cells are occupied, free or unknown.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 from scipy.spatial.transform import Rotation
 
-from seminspect.core.errors import InvalidInputError
+from seminspect.core.errors import FileFormatError, InvalidInputError
+from seminspect.core.io import save_npz_atomic
 from seminspect.geometry.raster import cells_touching_triangles
 from seminspect.geometry.transforms import as_point, as_points
+from seminspect.mapping.semantic_cloud import read_npz
 from seminspect.mapping.traversal import integrate_rays_kernel
 from seminspect.sensors import Frame, LidarScan
 from seminspect.worlds import World
@@ -33,6 +37,8 @@ OCCUPIED: int = 2
 
 #: Refuse maps larger than this many cells (2 GiB of uint8) with a clear error.
 MAX_CELLS = 2 << 30
+MAP_FORMAT = "seminspect.voxel-map"
+MAP_VERSION = 1
 
 
 @dataclass
@@ -143,6 +149,24 @@ class VoxelMap:
         grid.states[:] = np.where(occupied, OCCUPIED, FREE)
         return grid
 
+    @classmethod
+    def from_boxes(
+        cls, lower: ArrayLike, upper: ArrayLike, resolution: float, boxes: ArrayLike
+    ) -> VoxelMap:
+        """A known map of the box ``[lower, upper]``: cells overlapping any of ``boxes``
+        (``(B, 2, 3)``, lower and upper corners) are occupied, every other cell is free."""
+        grid = cls.empty(lower, upper, resolution)
+        grid.states[:] = FREE
+        corners = np.asarray(boxes, dtype=np.float64).reshape(-1, 2, 3)
+        if not np.all(np.isfinite(corners)):
+            raise InvalidInputError("box corners must be finite")
+        shape = np.asarray(grid.shape)
+        for lo, hi in (corners - grid.origin) / grid.resolution:
+            a = np.clip(np.floor(lo).astype(np.int64), 0, shape)
+            b = np.clip(np.ceil(hi).astype(np.int64), 0, shape)
+            grid.states[a[0] : b[0], a[1] : b[1], a[2] : b[2]] = OCCUPIED
+        return grid
+
     def integrate_rays(self, origins: ArrayLike, endpoints: ArrayLike, hit: ArrayLike) -> None:
         """Clear the cells along each ray and mark the end cell of every hit occupied.
 
@@ -224,3 +248,66 @@ class VoxelMap:
             grown = ndimage.binary_dilation(states == OCCUPIED, structure=ball)
             states[grown] = OCCUPIED
         return VoxelMap(self.origin.copy(), self.resolution, states)
+
+    def coarsened(self, resolution: float) -> VoxelMap:
+        """The same box at a coarser ``resolution``: each coarse cell takes the highest state of
+        the fine cells overlapping it (occupied over free over unknown, OctoMap's rule for inner
+        nodes), so no obstacle is lost."""
+        if not (math.isfinite(resolution) and resolution >= self.resolution):
+            raise InvalidInputError(
+                f"a coarser resolution than {self.resolution:g} m is needed, got {resolution!r}"
+            )
+        coarse = VoxelMap.empty(self.origin, self.upper, resolution)
+        states = self.states
+        for axis in range(3):
+            states = _coarsen_axis(states, axis, self.resolution / resolution, coarse.shape[axis])
+        coarse.states[:] = states
+        return coarse
+
+
+def _coarsen_axis(states: NDArray[np.uint8], axis: int, ratio: float, size: int) -> NDArray:
+    """Max of the fine cells overlapping each coarse cell along one axis (``ratio`` < = 1)."""
+    fine = np.arange(states.shape[axis])
+    first = np.minimum(np.floor(fine * ratio + 1e-9).astype(np.int64), size - 1)
+    last = np.minimum(np.floor((fine + 1) * ratio - 1e-9).astype(np.int64), size - 1)
+    out_shape = list(states.shape)
+    out_shape[axis] = size
+    out = np.zeros(out_shape, dtype=np.uint8)
+    for owner in (first, last):  # a fine cell overlaps at most two coarse ones
+        starts = np.flatnonzero(np.diff(owner, prepend=-1))
+        reduced = np.maximum.reduceat(states, starts, axis=axis)
+        index: list[slice | NDArray[np.int64]] = [slice(None)] * 3
+        index[axis] = owner[starts]
+        out[tuple(index)] = np.maximum(out[tuple(index)], reduced)
+    return out
+
+
+def save_map(path: str | os.PathLike[str], voxel_map: VoxelMap) -> Path:
+    """Write a map as a compressed ``.npz`` (atomically)."""
+    return save_npz_atomic(
+        path,
+        format=np.array(MAP_FORMAT),
+        version=np.array(MAP_VERSION),
+        origin=voxel_map.origin,
+        resolution=np.array(voxel_map.resolution),
+        states=voxel_map.states,
+    )
+
+
+def load_map(path: str | os.PathLike[str]) -> VoxelMap:
+    """Read a map written by :func:`save_map`; anything else is a :class:`FileFormatError`."""
+    arrays = read_npz(Path(path))
+    if "format" not in arrays or str(arrays["format"]) != MAP_FORMAT:
+        raise FileFormatError(f"{path}: not a seminspect voxel map")
+    if "version" not in arrays or int(arrays["version"]) != MAP_VERSION:
+        raise FileFormatError(f"{path}: voxel map version {arrays.get('version')} is not supported")
+    missing = [key for key in ("origin", "resolution", "states") if key not in arrays]
+    if missing:
+        raise FileFormatError(f"{path}: voxel map lacks {', '.join(missing)}")
+    states = arrays["states"]
+    if states.dtype != np.uint8 or states.ndim != 3 or states.size == 0 or states.max() > OCCUPIED:
+        raise FileFormatError(f"{path}: voxel states must be a non-empty 3D array of 0, 1, 2")
+    try:
+        return VoxelMap(arrays["origin"], float(arrays["resolution"]), states)
+    except (InvalidInputError, TypeError, ValueError) as exc:
+        raise FileFormatError(f"{path}: {exc}") from None

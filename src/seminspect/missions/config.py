@@ -44,6 +44,11 @@ class RobotConfig(_Strict):
         "what lies below the flight level)",
     )
 
+    def planning_band(self) -> tuple[float, float]:
+        """Height band a ground robot's planners keep clear [m]: above small bumps, up to half
+        a metre over the camera."""
+        return (0.3, max(1.0, self.body_height + 0.5))
+
 
 class InspectionConfig(_Strict):
     """FLIE's local view planner (002 eqs 1-2) and level completion (000 eq 8)."""
@@ -78,6 +83,11 @@ class MissionConfig(_Strict):
     mode: Mode | None = None
     noise: NoiseName = "realistic"
     planner: PlannerName = "hierarchical"
+    charge_planning_time: bool = Field(
+        False,
+        description="the robot waits for every planner call's wall time, so slow planning costs "
+        "mission time (000 Sec VII-D); off by default because wall time varies between runs",
+    )
     time_budget_s: float | None = Field(None, gt=0, description="simulated seconds")
     map_resolution: float = Field(0.3, ge=0.1, le=1.0, description="robot's occupancy map [m]")
     target_classes: tuple[str, ...] | None = None

@@ -4,14 +4,20 @@
 metres and handing a camera frame to the mission every ``camera_every_m`` (so targets are found
 in transit). Before each step it re-checks the route against the map it has just updated, and
 asks the local planner for a new route when the old one now crosses an obstacle.
+
+Simulated time does not pass while a planner computes. With ``charge_planning_time`` the robot
+stands still for each route's planning wall time, as a real robot waits for its planner, so a
+slow planner costs mission time (the baseline comparison of 000 Sec VII-D).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -21,12 +27,21 @@ from seminspect.core.errors import PlanningError
 from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap
 from seminspect.missions.metrics import Timers
 from seminspect.missions.platform import Platform
+from seminspect.planning.grid_search import GridPath
 from seminspect.planning.gridmap import CostGrid, planar_states
 from seminspect.planning.local import LocalPlanner
 from seminspect.sensors import Frame, LidarScan
 
 #: Metres a goal may be missed by when the robot already stands within the goal radius plus this.
 ARRIVAL_SLACK = 0.05
+
+
+class RoutePlanner(Protocol):
+    """What the navigator asks of a planner: a route on the robot's current map."""
+
+    def plan(
+        self, voxel_map: VoxelMap, start: ArrayLike, goal: ArrayLike, goal_radius: float = 0.0
+    ) -> GridPath: ...
 
 
 @dataclass
@@ -38,6 +53,8 @@ class NavigationStats:
     local_planning_s: list[float] = field(default_factory=list)
     replans: int = 0
     blocked: int = 0
+    #: Wall time of every planner call of the mission (routes, graph queries, views) [s].
+    planning_s: float = 0.0
 
 
 class Navigator:
@@ -51,6 +68,7 @@ class Navigator:
         lidar_every_m, camera_every_m: sensing intervals while driving.
         clear_misses_to: free space is cleared along LiDAR beams with no return up to this range.
         timers: where sensing, planning and driving time is charged.
+        charge_planning_time: the robot waits for each route's planning wall time.
     """
 
     def __init__(
@@ -64,9 +82,11 @@ class Navigator:
         camera_every_m: float,
         clear_misses_to: float,
         timers: Timers | None = None,
+        charge_planning_time: bool = False,
     ) -> None:
         self.timers = timers or Timers()
         self.platform = platform
+        self.charge_planning_time = charge_planning_time
         self.occupancy = occupancy
         self.planner = planner
         self.on_frame = on_frame
@@ -100,7 +120,8 @@ class Navigator:
         if self.occupancy.contains_index(cell):
             self.occupancy.states[tuple(cell)] = OCCUPIED
 
-    def _grid(self, known_only: bool = False) -> CostGrid:
+    def cost_grid(self, known_only: bool = False) -> CostGrid:
+        """The planner's grid on the map as it is now (costs filled as they are asked for)."""
         planner = self.known_planner if known_only else self.planner
         return CostGrid.build(self.occupancy, planner.model, planner.band, lazy=True)
 
@@ -110,7 +131,7 @@ class Navigator:
         """Whether the robot's map lets it drive straight from ``a`` to ``b`` (through unknown
         space too, unless ``known_only``)."""
         with self.timers("planning"):
-            return (grid or self._grid(known_only)).segment_is_free(a, b)
+            return (grid or self.cost_grid(known_only)).segment_is_free(a, b)
 
     # ----------------------------------------------------------------- driving
     def drive(
@@ -159,7 +180,7 @@ class Navigator:
     ) -> bool:
         """The segment is free, or free once past the inflation margin the robot may stand in
         (after a close view; the planner starts such routes from the nearest free cell)."""
-        grid = self._grid(known_only)
+        grid = self.cost_grid(known_only)
         if self.segment_is_free(here, target, grid):
             return True
         escape = self.planner.model.robot_radius + self.occupancy.resolution
@@ -171,31 +192,44 @@ class Navigator:
         self,
         goal: ArrayLike,
         radius: float,
+        *,
         final_yaw: float | None = None,
         attempts: int = 5,
         known_only: bool = False,
+        planner: RoutePlanner | None = None,
     ) -> bool:
         """Plan and drive to within ``radius`` of ``goal``, replanning as the map grows; with
-        ``known_only`` the route stays in observed free space."""
-        planner = self.known_planner if known_only else self.planner
+        ``known_only`` the route stays in observed free space. ``planner`` replaces the local
+        planner (e.g. by the volumetric baseline)."""
+        if planner is None:
+            planner = self.known_planner if known_only else self.planner
         goal_point = np.asarray(goal, dtype=np.float64)
         for _ in range(attempts):
             if self._arrived(goal_point, radius):
                 break
             self.stats.local_plans += 1
+            started = time.perf_counter()
             try:
                 with self.timers("planning"):
                     path = planner.plan(self.occupancy, self.platform.position, goal_point, radius)
             except PlanningError:
                 self.stats.local_failures += 1
+                self.planned(time.perf_counter() - started)
                 return False
             self.stats.local_planning_s.append(path.planning_time)
+            self.planned(path.planning_time)
             if self.drive(path.waypoints, known_only=known_only):
                 break
         arrived = self._arrived(goal_point, radius)
         if arrived and final_yaw is not None:
             self.platform.turn_to(final_yaw)
         return arrived
+
+    def planned(self, seconds: float) -> None:
+        """Account ``seconds`` of planning wall time; the robot waits for it when charged."""
+        self.stats.planning_s += seconds
+        if self.charge_planning_time:
+            self.platform.wait(seconds)
 
     def _arrived(self, goal: NDArray[np.float64], radius: float) -> bool:
         here = self.platform.position

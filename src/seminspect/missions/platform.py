@@ -61,6 +61,8 @@ class Platform(Protocol):
 
     def turn_to(self, yaw: float) -> Motion: ...
 
+    def wait(self, seconds: float) -> None: ...
+
     def capture(self) -> Frame: ...
 
     def detect(self, frame: Frame, level: str, labels: Iterable[str]) -> list[Detection]: ...
@@ -169,6 +171,10 @@ class SimulatedPlatform:
 
     def turn_to(self, yaw: float) -> Motion:
         return self.move_to(self.position, yaw)
+
+    def wait(self, seconds: float) -> None:
+        """Stand still for ``seconds`` (e.g. while a planner thinks)."""
+        self.robot.wait(seconds)
 
     # ----------------------------------------------------------------- sensing
     def capture(self) -> Frame:

@@ -217,6 +217,7 @@ def mission_metrics(
         },
         "table6": {
             "cpu_load_pct": cpu.load_pct(),
+            "planning_load_pct": planning_load_pct(mission),
             "localisation_rmse_m": _finite(score.rmse(horizontal=True)),
             "localisation_rmse_3d_m": _finite(score.rmse(horizontal=False)),
             **coverage_metrics(mission, world, score),
@@ -242,10 +243,19 @@ def mission_metrics(
             "hierarchical_queries": len(planning),
             "local_plans": mission.navigator.stats.local_plans,
             "local_planning_ms_mean": 1e3 * float(np.mean(local)) if local else None,
+            "planning_wall_s": mission.navigator.stats.planning_s,
+            "planning_time_charged": config.charge_planning_time,
             "wall_time_by_category_s": {k: round(v, 3) for k, v in mission.timers.seconds.items()},
         },
         "queries": [asdict(a) for a in answers],
     }
+
+
+def planning_load_pct(mission: XFlie) -> float | None:
+    """Planner wall time per simulated second, in percent of one core: the load the planners
+    would put on a robot running in real time."""
+    sim_time = mission.platform.time
+    return 100.0 * mission.navigator.stats.planning_s / sim_time if sim_time > 0 else None
 
 
 def coverage_metrics(mission: XFlie, world: World, score: TargetScore) -> dict[str, Any]:
@@ -275,6 +285,7 @@ def _write_outputs(
     run: RunDirectory, mission: XFlie, metrics: dict[str, Any], answers: Sequence[QueryAnswer]
 ) -> None:
     run.write_graph(mission.graph)
+    run.write_map(mission.occupancy)
     run.write_metrics(metrics)
     trajectory = mission.platform.robot.trajectory if hasattr(mission.platform, "robot") else None
     if trajectory is not None:

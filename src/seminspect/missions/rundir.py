@@ -11,6 +11,7 @@ Layout::
       events.jsonl      one JSON object per decision (survey, selection, arrival, level, ...),
                         rewritten whole at every checkpoint
       metrics.json      Table 3 and Table 6 figures, mission time, distance
+      map.npz           the robot's final occupancy map (seminspect.voxel-map)
       summary.md        the same, for people
       images/           the view images the graph refers to
       *.png             pictures
@@ -31,19 +32,23 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from seminspect.core.errors import InvalidInputError
+from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.core.io import (
     atomic_write_bytes,
     atomic_write_text,
     dumps_json,
+    read_versioned_json,
     write_versioned_json,
 )
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.io import save_graph
+from seminspect.mapping.voxel import VoxelMap, save_map
+from seminspect.worlds import World, generate_world
 
 STATUS_FORMAT = "seminspect.run-status"
 METRICS_FORMAT = "seminspect.run-metrics"
 CONFIG_FORMAT = "seminspect.mission-config"
+MAP_FILE = "map.npz"
 
 
 class RunDirectory:
@@ -88,6 +93,10 @@ class RunDirectory:
     def write_metrics(self, metrics: dict[str, Any]) -> None:
         write_versioned_json(self.path("metrics.json"), METRICS_FORMAT, 1, metrics, indent=2)
 
+    def write_map(self, occupancy: VoxelMap) -> Path:
+        """The robot's occupancy map as it was at the end of the run."""
+        return save_map(self.path(MAP_FILE), occupancy)
+
     def write_summary(self, markdown: str) -> None:
         atomic_write_text(self.path("summary.md"), markdown)
 
@@ -118,3 +127,25 @@ class RunDirectory:
     @property
     def events(self) -> list[dict[str, Any]]:
         return list(self._events)
+
+
+def read_run_config(run_dir: Path) -> dict[str, Any]:
+    """The resolved mission configuration a run was made with."""
+    return read_versioned_json(run_dir / "config.json", CONFIG_FORMAT, [1])["config"]
+
+
+def load_run_world(run_dir: Path) -> World:
+    """Regenerate the world a run used (worlds are deterministic under their seed)."""
+    config = read_run_config(run_dir)
+    return generate_world(config["world"], config["scenario"], seed=config["seed"])
+
+
+def load_trajectory(run_dir: Path) -> NDArray[np.float64]:
+    """Rows of ``t, x, y, z, yaw, odom_x, odom_y, odom_z, odom_yaw`` (none when absent)."""
+    path = run_dir / "trajectory.csv"
+    if not path.exists():
+        return np.empty((0, 9))
+    try:
+        return np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    except ValueError as exc:
+        raise FileFormatError(f"{path}: {exc}") from None

@@ -7,6 +7,8 @@ One mission, step by step:
 2. Target selection by utility (eq 6). Navigation: the hierarchical planner over the 3DLSG for
    the known part of the route (to the inspected target nearest the goal), then the local
    planner on the robot's own occupancy map into unknown space, to within ``ε`` of the target.
+   With ``planner="volumetric"`` (000 Sec VII-D's baseline) the volumetric planner, rebuilt on
+   the robot's map at 0.4 m for every query, plans the whole way instead.
 3. ``π^insp``: ``Level-0`` starts at the target (eq 7). At every view the pose is registered
    (eq 9) with its image, part detections go to the interim Pose-Feature graph, and FLIE's local
    view planner (002 eqs 1-2) gives the next view. A level ends when, back within
@@ -18,12 +20,17 @@ One mission, step by step:
    around the inspected target.
 5. Repeat until no uninspected target remains (then visit exploration frontiers to find more)
    or the time budget ends.
+
+Every planner call's wall time (routes, graph queries, Target-layer edges, view poses) is
+recorded; with ``charge_planning_time`` the robot also waits for it, so planning costs mission
+time as on a real robot.
 """
 
 from __future__ import annotations
 
 import itertools
 import math
+import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
@@ -51,12 +58,14 @@ from seminspect.perception.similarity import (
     SceneMatcher,
     scene_similarity,
 )
+from seminspect.planning.grid_search import GridPath
 from seminspect.planning.gridmap import CostModel
 from seminspect.planning.hierarchical import HierarchicalPlanner, RoutePlan
 from seminspect.planning.local import LocalPlanner
 from seminspect.planning.smoothing import refine_path
 from seminspect.planning.utility import UtilityTerms, select_target
 from seminspect.planning.view_planner import ViewConstraints, next_view_pose
+from seminspect.planning.volumetric import RebuildingVolumetricPlanner
 from seminspect.sensors import Detection, Frame
 
 #: Voxel size of the cloud kept of the target under inspection [m].
@@ -83,6 +92,10 @@ PLANNING_MARGIN = 0.2
 LEVEL_SWEEP_CAP = 2.0 * math.pi + math.radians(40)
 #: A part belongs to the inspected target when this share of its mask lies on the target's.
 PART_OVERLAP = 0.5
+#: The volumetric baseline's map resolution and risk band (000 Sec VII-D: D*+ on M_0.4, risk
+#: parameter 0.2) [m].
+BASELINE_RESOLUTION = 0.4
+BASELINE_RISK_RADIUS = 0.2
 
 
 @dataclass
@@ -169,9 +182,20 @@ class XFlie:
             hfov_deg=self.params.fov_deg,
             vfov_deg=platform_vfov(self.params),
         )
-        model = CostModel(config.robot.radius + PLANNING_MARGIN, risk_radius=0.3, unknown_cost=1.0)
-        band = (0.3, max(1.0, config.robot.body_height + 0.5))
+        clearance = config.robot.radius + PLANNING_MARGIN
+        model = CostModel(clearance, risk_radius=0.3, unknown_cost=1.0)
+        band = config.robot.planning_band()
         self.local = LocalPlanner(model, config.mode or "ground", band=band)
+        #: The paper's baseline planner between targets (``planner="volumetric"``).
+        self.volumetric = (
+            RebuildingVolumetricPlanner(
+                CostModel(clearance, risk_radius=BASELINE_RISK_RADIUS, unknown_cost=1.0),
+                band if config.mode == "ground" else None,
+                resolution=BASELINE_RESOLUTION,
+            )
+            if config.planner == "volumetric"
+            else None
+        )
         self.navigator = Navigator(
             platform,
             occupancy,
@@ -181,6 +205,7 @@ class XFlie:
             camera_every_m=config.exploration.camera_every_m,
             clear_misses_to=self.params.d_max,
             timers=self.timers,
+            charge_planning_time=config.charge_planning_time,
         )
         self.target_cloud = PointSet(TARGET_VOXEL)
         self.unreachable: set[str] = set()
@@ -356,7 +381,7 @@ class XFlie:
         self._event("selected", target=target.id, utility=round(target.utility, 4))
         self._hierarchical_leg(goal)
         for radius in (self.params.epsilon, self.params.epsilon + 1.0, self.params.epsilon + 2.5):
-            arrived = self.navigator.go_to(goal, radius, final_yaw=None)
+            arrived = self.navigator.go_to(goal, radius, planner=self.volumetric)
             if arrived:
                 self._event("arrived", target=target.id)
                 return True
@@ -395,9 +420,14 @@ class XFlie:
                 (goal - here)[:2]
             ):
                 return  # the graph gets the robot no closer than driving straight for it
-            plan = self.planner.plan(entry, here)
+            try:
+                plan = self.planner.plan(entry, here)
+            except PlanningError:  # the Target layer does not join the two; drive without it
+                return
             self.record_plan(entry, plan)
-            route = refine_path(plan.waypoints, self.navigator.segment_is_free).waypoints
+            refined = refine_path(plan.waypoints, self.navigator.cost_grid())
+            self.navigator.planned(plan.timing.total_s + refined.refine_time)
+            route = refined.waypoints
         self.navigator.drive(route)
 
     # ----------------------------------------------------------------- inspection
@@ -415,6 +445,7 @@ class XFlie:
             if level > 0 and not self._climb(target, heights):
                 break
             self._inspect_level(target, heights)
+            self._close_level()
             if self.config.mode != "aerial" or self.time_left <= 0:
                 break
         if len(LayeredSemanticGraph.entry_level(target).poses) < 3:
@@ -590,10 +621,13 @@ class XFlie:
                 update={"overlap_h": overlap, "d_view": self.view.d_view * closer}
             )
             with self.timers("planning"):
+                started = time.perf_counter()
                 try:
                     pose = next_view_pose(self.platform.position, points, view)
                 except PlanningError:
                     return False
+                finally:
+                    self.navigator.planned(time.perf_counter() - started)
             if self._move_to_view(pose.position, pose.yaw):
                 return True
         return False
@@ -632,18 +666,52 @@ class XFlie:
         reach = self.view.d_view * math.tan(half - self.camera_pitch)
         if self.platform.position[2] + reach >= top:
             return False
-        goal = self.platform.position + np.array([0.0, 0.0, self.view.vertical_step])
+        here = self.platform.position
+        goal = here + np.array([0.0, 0.0, self.view.vertical_step])
         with self.timers("driving"):
             motion = self.platform.move_to(goal, self.platform.yaw)
         if not motion.reached:
             return False
         with self.timers("graph"):
-            self.graph.begin_level(self._view_pose(image=None))
+            self.graph.begin_level(self._view_pose(image=None), via=self._climb_route(here))
         self._event("level", target=target.id, height=round(float(goal[2]), 2))
         return True
 
+    def _close_level(self) -> None:
+        """Eq (10) for the level just inspected. Its ring edge (last pose back to the level's
+        start) is a straight segment the robot never drove, so it is added only where the
+        robot's map shows that segment free (known space, the planners' clearance)."""
+        level = self.graph.current_level
+        assert level is not None
+        poses = level.poses
+        ring = len(poses) > 1 and self.navigator.segment_is_free(
+            poses[-1].position, level.position, known_only=True
+        )
+        with self.timers("graph"):
+            self.graph.close_level(close_ring=ring)
+        if len(poses) > 1 and not ring:
+            self._event("ring-left-open", level=level.id)
+
+    def _climb_route(self, climb_start: NDArray[np.float64]) -> NDArray[np.float64]:
+        """How the robot got from the closing level's start to where it climbed: through the
+        ring edge when the level kept it, otherwise along its view poses as it drove them."""
+        level = self.graph.current_level
+        assert level is not None
+        poses = level.poses
+        ring = len(poses) > 1 and self.graph.edge(poses[-1].id, level.id) is not None
+        chain = [p.position for p in (poses[-1:] if ring else poses)]
+        if not chain or np.linalg.norm(chain[-1] - climb_start) > 1e-9:
+            chain.append(climb_start)
+        return np.array(chain)
+
     def _connect_inspected(self, target: TargetNode) -> None:
-        """``v_I - v_I`` edges to the nearest inspected targets, through known free space."""
+        """``v_I - v_I`` edges to the nearest inspected targets, through known free space.
+
+        The robot does not drive these routes now, so they keep half a cell diagonal more
+        clearance than its routes where they can: the planner measures between cell centres,
+        and a straight segment may pass anywhere within the cells it crosses. Where no route
+        keeps it, the robot's own clearance is used, so the Target layer stays as connected.
+        """
         inspected = [t for t in self.graph.targets(TargetStatus.INSPECTED) if t is not target]
         entry = LayeredSemanticGraph.entry_level(target).position
         inspected.sort(
@@ -651,18 +719,24 @@ class XFlie:
                 np.linalg.norm(LayeredSemanticGraph.entry_level(t).position - entry)
             )
         )
-        known = LocalPlanner(
-            CostModel(self.local.model.robot_radius, risk_radius=0.0, unknown_cost=None),
-            self.local.mode,
-            band=self.local.band or (0.3, 1.5),
-        )
+        dims = 2 if self.local.mode == "ground" else 3
+        slack = 0.5 * self.occupancy.resolution * math.sqrt(dims)
+        planners = [
+            LocalPlanner(
+                CostModel(self.local.model.robot_radius + extra, 0.0, unknown_cost=None),
+                self.local.mode,
+                band=self.local.band or (0.3, 1.5),
+            )
+            for extra in (slack, 0.0)
+        ]
         for other in inspected[:3]:
             start = LayeredSemanticGraph.entry_level(other).position
             with self.timers("planning"):
-                try:
-                    path = known.plan(self.occupancy, start, entry)
-                except PlanningError:
-                    continue
+                started = time.perf_counter()
+                path = _first_route(planners, self.occupancy, start, entry)
+                self.navigator.planned(time.perf_counter() - started)
+            if path is None:
+                continue
             via = path.waypoints[1:-1]
             with self.timers("graph"):
                 self.graph.connect_targets(other.id, target.id, via if len(via) else None)
@@ -697,6 +771,21 @@ class XFlie:
                     for t in terms
                 },
             )
+
+
+def _first_route(
+    planners: Iterable[LocalPlanner],
+    occupancy: VoxelMap,
+    start: NDArray[np.float64],
+    goal: NDArray[np.float64],
+) -> GridPath | None:
+    """The route of the first planner that finds one, if any."""
+    for planner in planners:
+        try:
+            return planner.plan(occupancy, start, goal)
+        except PlanningError:
+            continue
+    return None
 
 
 class PointSet:

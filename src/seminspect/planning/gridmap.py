@@ -177,32 +177,76 @@ def _segment_is_free(grid: GridArgs, start: NDArray[np.float64], end: NDArray[np
 
     A voxel walk (Amanatides & Woo). Where the segment crosses exactly through an edge or corner
     it steps diagonally, like a diagonal grid move: touching a blocked cell only along an edge or
-    at a corner counts as free, so raw grid routes pass the check too.
+    at a corner counts as free, so raw grid routes pass the check too. Scalars throughout: small
+    arrays per step would cost more than the walk.
     """
     shape = grid[2]
-    cell = np.minimum(np.maximum(np.floor(start), 0), shape - 1).astype(np.int64)
-    last = np.minimum(np.maximum(np.floor(end), 0), shape - 1).astype(np.int64)
-    delta = end - start
-    step = np.sign(delta).astype(np.int64)
+    cell = np.empty(3, dtype=np.int64)
+    last = np.empty(3, dtype=np.int64)
+    step = np.zeros(3, dtype=np.int64)
     t_max = np.full(3, np.inf)
     t_delta = np.full(3, np.inf)
     for a in range(3):
-        if step[a] != 0:
+        cell[a] = int(min(max(math.floor(start[a]), 0.0), shape[a] - 1))
+        last[a] = int(min(max(math.floor(end[a]), 0.0), shape[a] - 1))
+        delta = end[a] - start[a]
+        if delta != 0.0:
+            step[a] = 1 if delta > 0.0 else -1
             boundary = cell[a] + (step[a] > 0)
-            t_max[a] = (boundary - start[a]) / delta[a]
-            t_delta[a] = step[a] / delta[a]
+            t_max[a] = (boundary - start[a]) / delta
+            t_delta[a] = step[a] / delta
+    cost = grid[1]
+    i, j, k = cell[0], cell[1], cell[2]
     while True:
-        if not math.isfinite(cell_cost(grid, (cell[0] * shape[1] + cell[1]) * shape[2] + cell[2])):
+        flat = (i * shape[1] + j) * shape[2] + k
+        value = cost[flat]
+        if value == 0.0:  # not evaluated yet (lazy grid); a call only then, calls cost most
+            value = cell_cost(grid, flat)
+        if not math.isfinite(value):
             return False
-        t_next = t_max.min()
-        if (cell == last).all() or t_next > 1.0 + 1e-9:
+        t_next = min(t_max[0], t_max[1], t_max[2])
+        if (i == last[0] and j == last[1] and k == last[2]) or t_next > 1.0 + 1e-9:
             return True
-        for a in range(3):
-            if t_max[a] <= t_next + 1e-9:
-                cell[a] += step[a]
-                t_max[a] += t_delta[a]
-        if (cell < 0).any() or (cell >= shape).any():
+        if t_max[0] <= t_next + 1e-9:
+            i += step[0]
+            t_max[0] += t_delta[0]
+        if t_max[1] <= t_next + 1e-9:
+            j += step[1]
+            t_max[1] += t_delta[1]
+        if t_max[2] <= t_next + 1e-9:
+            k += step[2]
+            t_max[2] += t_delta[2]
+        if i < 0 or j < 0 or k < 0 or i >= shape[0] or j >= shape[1] or k >= shape[2]:
             return True
+
+
+@numba.njit(cache=True)
+def _segment_in_grid_is_free(
+    grid: GridArgs, start: NDArray[np.float64], end: NDArray[np.float64]
+) -> bool:
+    """:func:`_segment_is_free` for ends that may lie outside the grid (then: not free)."""
+    shape = grid[2]
+    for a in range(3):
+        for value in (start[a], end[a]):
+            if not (0.0 <= value < shape[a]):
+                return False
+    return _segment_is_free(grid, start, end)
+
+
+@numba.njit(cache=True)
+def _shortcut(grid: GridArgs, cells: NDArray[np.float64]) -> NDArray[np.int64]:
+    """From each kept waypoint, jump to the farthest later one joined by a free segment."""
+    n = cells.shape[0]
+    kept = np.empty(n, dtype=np.int64)
+    kept[0], count, i = 0, 1, 0
+    while i < n - 1:
+        j = n - 1
+        while j > i + 1 and not _segment_in_grid_is_free(grid, cells[i], cells[j]):
+            j -= 1
+        kept[count] = j
+        count += 1
+        i = j
+    return kept[:count]
 
 
 @numba.njit(cache=True)
@@ -335,14 +379,23 @@ class CostGrid:
 
         Both ends must lie in the grid (planar grids ignore z).
         """
-        ua = (np.asarray(a, dtype=np.float64) - self.origin) / self.resolution
-        ub = (np.asarray(b, dtype=np.float64) - self.origin) / self.resolution
+        ends = self._cell_units(np.array([a, b], dtype=np.float64))
+        return bool(_segment_in_grid_is_free(self.kernel_args, ends[0], ends[1]))
+
+    def shortcut(self, waypoints: NDArray[np.float64]) -> NDArray[np.int64]:
+        """Indices of the waypoints ``(N, 3)`` that greedy shortcutting with
+        :meth:`segment_is_free` keeps (see :func:`~seminspect.planning.smoothing.shortcut`),
+        the whole loop in one compiled call."""
+        return _shortcut(
+            self.kernel_args, self._cell_units(np.asarray(waypoints, dtype=np.float64))
+        )
+
+    def _cell_units(self, points: NDArray[np.float64]) -> NDArray[np.float64]:
+        """World points in (fractional) cell units; planar grids put them mid-layer."""
+        units = (points - self.origin) / self.resolution
         if self.planar:
-            ua[2] = ub[2] = 0.5
-        hi = np.asarray(self.shape)
-        if np.any(ua < 0) or np.any(ub < 0) or np.any(ua >= hi) or np.any(ub >= hi):
-            return False
-        return bool(_segment_is_free(self.kernel_args, ua, ub))
+            units[:, 2] = 0.5
+        return units
 
 
 def format_point(point: ArrayLike) -> str:

@@ -27,9 +27,9 @@ from itertools import pairwise
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial import cKDTree
 
 from seminspect.core.errors import PlanningError
+from seminspect.geometry.nearest import NearestIndex
 from seminspect.geometry.transforms import as_point, yaw_from_quat
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.model import (
@@ -110,6 +110,21 @@ class _LocalIndex:
     csr: CsrGraph
     #: Nodes ``0 .. n_levels - 1`` are levels (``Level-0`` first), the rest are poses.
     n_levels: int
+    #: Via points of edges realised by a polyline, by (from, to) node, in travel order.
+    vias: dict[tuple[int, int], NDArray[np.float64]]
+
+    def points(self, nodes: NDArray[np.int64]) -> NDArray[np.float64]:
+        """The metric path through ``nodes``: their positions and any via points between."""
+        coords = self.csr.coords[nodes]
+        if not self.vias:
+            return coords
+        chunks = [coords[:1]]
+        for k, step in enumerate(pairwise(nodes.tolist())):
+            via = self.vias.get(step)
+            if via is not None:
+                chunks.append(via)
+            chunks.append(coords[k + 1 : k + 2])
+        return np.concatenate(chunks)
 
 
 @dataclass(slots=True)
@@ -122,7 +137,7 @@ class _Network:
     target_csr: CsrGraph
     target_edges: dict[tuple[int, int], Edge]
     locals: list[_LocalIndex]
-    tree: cKDTree | None
+    nearest: NearestIndex | None
     owner: NDArray[np.int64]
     local_of: NDArray[np.int64]
 
@@ -237,7 +252,7 @@ class HierarchicalPlanner:
             target_csr=CsrGraph.from_edges(coords.reshape(-1, 3), pairs, weights),
             target_edges=edges,
             locals=locals_,
-            tree=cKDTree(np.vstack(points)) if points else None,
+            nearest=NearestIndex.build(np.vstack(points)) if points else None,
             owner=owner,
             local_of=local_of,
         )
@@ -263,7 +278,12 @@ class HierarchicalPlanner:
             [(index[e.u], index[e.v]) for e in spatial],
             [e.weight for e in spatial],
         )
-        local = _LocalIndex([node.id for node in nodes], index, csr, len(levels))
+        vias: dict[tuple[int, int], NDArray[np.float64]] = {}
+        for e in spatial:
+            if e.via is not None:
+                vias[(index[e.u], index[e.v])] = e.via
+                vias[(index[e.v], index[e.u])] = e.via[::-1]
+        local = _LocalIndex([node.id for node in nodes], index, csr, len(levels), vias)
         self._local_cache[target.id] = local
         return local
 
@@ -295,9 +315,9 @@ class HierarchicalPlanner:
         return target, network.locals[target].index[node.id], terminal
 
     def _localise(self, network: _Network, position: NDArray[np.float64]) -> tuple[int, int, float]:
-        if network.tree is None:
+        if network.nearest is None:
             raise PlanningError("the graph has no inspected targets to plan over")
-        distance, row = network.tree.query(position)
+        row, distance = network.nearest.nearest(position)
         return int(network.owner[row]), int(network.local_of[row]), float(distance)
 
     def _localisation(
@@ -327,7 +347,7 @@ class HierarchicalPlanner:
         query: str | None,
     ) -> RoutePlan:
         visits = [(hops[0], segments[0].tolist())]
-        chunks = [origin[None, :], network.locals[hops[0]].csr.coords[segments[0]]]
+        chunks = [origin[None, :], network.locals[hops[0]].points(segments[0])]
         target_length = 0.0
         for a, b in pairwise(hops):
             edge = network.target_edges[(a, b)]
@@ -339,15 +359,15 @@ class HierarchicalPlanner:
             chunks.append(network.locals[b].csr.coords[:1])
         if len(segments) > 1:
             visits.append((hops[-1], segments[1][1:].tolist()))
-            chunks.append(network.locals[hops[-1]].csr.coords[segments[1][1:]])
+            chunks.append(network.locals[hops[-1]].points(segments[1])[1:])
         ids: list[str] = []
         levels: list[str] = []
         poses: list[str] = []
         for target, local_nodes in visits:
-            local = network.locals[target]
-            for i in local_nodes:
-                ids.append(local.node_ids[i])
-                (levels if i < local.n_levels else poses).append(local.node_ids[i])
+            names, n_levels = network.locals[target].node_ids, network.locals[target].n_levels
+            ids += [names[i] for i in local_nodes]
+            levels += [names[i] for i in local_nodes if i < n_levels]
+            poses += [names[i] for i in local_nodes if i >= n_levels]
         waypoints = np.concatenate(chunks)
         t0, t1, t2, _ = timing
         return RoutePlan(
@@ -385,9 +405,11 @@ class HierarchicalPlanner:
         elif verb is Verb.OBSERVE and isinstance(goal, TargetNode | LevelNode):
             target = goal if isinstance(goal, TargetNode) else self.graph.node(goal.target_id)
             focus = target.position
-        if focus is None or np.allclose(focus[:2], end[:2]):
+        if focus is None:
             return None
-        return math.atan2(focus[1] - end[1], focus[0] - end[0])
+        dx, dy = float(focus[0] - end[0]), float(focus[1] - end[1])
+        # Plain floats: numpy's allclose costs more than the searches of a query.
+        return None if math.hypot(dx, dy) <= 1e-8 else math.atan2(dy, dx)
 
 
 class _Searches:

@@ -88,7 +88,7 @@ class LocalPlanner:
         grid = CostGrid.build(voxel_map, self.model, self.band, lazy=True)
         query = make_query(grid, start, goal, goal_radius, self.start_tolerance)
         raw = search(grid, query, self.heuristic_weight, started=t0)
-        refined = refine_path(raw.waypoints, grid.segment_is_free).waypoints
+        refined = refine_path(raw.waypoints, grid).waypoints
         return dataclasses.replace(
             raw,
             waypoints=refined,

@@ -22,6 +22,7 @@ from enum import Enum
 
 from seminspect.core.errors import InvalidInputError, PlanningError
 from seminspect.core.names import unknown_name
+from seminspect.graphs.lsg import naming
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.model import FeatureNode, LevelNode, PoseNode
 
@@ -38,6 +39,7 @@ _VERBS = {
     "observe": Verb.OBSERVE,
     "inspect": Verb.OBSERVE,
 }
+_VERBS_LONGEST_FIRST = sorted(_VERBS.items(), key=lambda item: -len(item[0]))
 _SEPARATORS = re.compile(r"\s+(?:in|of|at)\s+")
 _LEVEL = re.compile(r"^level-(\d+)$")
 _NAME = re.compile(r"^[a-z][a-z0-9_.-]*$")
@@ -102,7 +104,7 @@ def parse_query(text: str) -> Query:
 
 def _split_verb(body: str) -> tuple[Verb, str]:
     lowered = body.lower()
-    for phrase, verb in sorted(_VERBS.items(), key=lambda item: -len(item[0])):
+    for phrase, verb in _VERBS_LONGEST_FIRST:
         if lowered == phrase:
             raise InvalidInputError(f"query {body!r} names no node; e.g. '{phrase} car-1'")
         if lowered.startswith(phrase + " "):
@@ -130,11 +132,13 @@ def resolve_query(graph: LayeredSemanticGraph, query: Query) -> str:
         scope = levels
     if query.node is None:
         return scope[0].id
+    # A pose or feature's id is its level's id joined with its (lower-case) name, so a lookup
+    # by id finds it without scanning the level's nodes.
     matches = [
-        node for level in scope for node in _named_nodes(level) if node.name.lower() == query.node
+        node_id for level in scope if (node_id := naming.join(level.id, query.node)) in graph
     ]
     if len(matches) == 1:
-        return matches[0].id
+        return matches[0]
     where = f"{scope[0].name} of {target.id}" if query.level else target.id
     if not matches:
         nodes = [node for level in scope for node in _named_nodes(level)]
@@ -142,7 +146,7 @@ def resolve_query(graph: LayeredSemanticGraph, query: Query) -> str:
         names = [node.name for node in nodes if isinstance(node, wanted)]
         kind = "pose" if wanted is PoseNode else "feature"
         raise unknown_name(kind, query.node, names, f"in {where}")
-    places = ", ".join(node.id for node in matches)
+    places = ", ".join(matches)
     raise InvalidInputError(f"{query.node!r} is ambiguous in {where} ({places}); name the level")
 
 

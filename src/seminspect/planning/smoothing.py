@@ -10,10 +10,12 @@ hierarchical and volumetric path lengths).
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -41,16 +43,27 @@ def remove_collinear(waypoints: ArrayLike, tol: float = 1e-9) -> NDArray[np.floa
     pts = as_points(waypoints, "waypoints")
     if len(pts) < 3:
         return pts.copy()
-    keep = [0]
-    for n in range(1, len(pts) - 1):
-        a, b, c = pts[keep[-1]], pts[n], pts[n + 1]
+    return pts[_collinear_kept(pts, float(tol))]
+
+
+@numba.njit(cache=True)
+def _collinear_kept(pts: NDArray[np.float64], tol: float) -> NDArray[np.int64]:
+    """Indices kept: a point stays when it leaves the line from the last kept point to the next
+    point, or turns back along it."""
+    n = pts.shape[0]
+    keep = np.empty(n, dtype=np.int64)
+    keep[0], count = 0, 1
+    for m in range(1, n - 1):
+        a, b, c = pts[keep[count - 1]], pts[m], pts[m + 1]
         ab, ac = b - a, c - a
-        off_line = np.linalg.norm(np.cross(ab, ac)) > tol * max(np.linalg.norm(ac), 1.0)
+        cross = np.cross(ab, ac)
+        off_line = math.sqrt(np.dot(cross, cross)) > tol * max(math.sqrt(np.dot(ac, ac)), 1.0)
         backwards = np.dot(ab, ac) < 0 or np.dot(ab, ab) > np.dot(ac, ac)
         if off_line or backwards:
-            keep.append(n)
-    keep.append(len(pts) - 1)
-    return pts[keep]
+            keep[count] = m
+            count += 1
+    keep[count] = n - 1
+    return keep[: count + 1]
 
 
 def shortcut(waypoints: ArrayLike, segment_is_free: SegmentCheck) -> NDArray[np.float64]:
@@ -81,11 +94,18 @@ class Refinement:
     refine_time: float
 
 
-def refine_path(waypoints: ArrayLike, segment_is_free: SegmentCheck) -> Refinement:
-    """Remove collinear vertices, then :func:`shortcut`; reports raw and refined lengths."""
+def refine_path(waypoints: ArrayLike, segment_is_free: SegmentCheck | CostGrid) -> Refinement:
+    """Remove collinear vertices, then :func:`shortcut`; reports raw and refined lengths.
+
+    Given a :class:`CostGrid`, its segment check is used and the shortcut loop runs compiled.
+    """
     t0 = time.perf_counter()
     pts = as_points(waypoints, "waypoints")
-    refined = shortcut(remove_collinear(pts), segment_is_free)
+    simple = remove_collinear(pts)
+    if isinstance(segment_is_free, CostGrid):
+        refined = simple[segment_is_free.shortcut(simple)]
+    else:
+        refined = shortcut(simple, segment_is_free)
     return Refinement(refined, path_length(pts), path_length(refined), time.perf_counter() - t0)
 
 

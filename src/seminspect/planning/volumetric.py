@@ -20,6 +20,7 @@ so ``bench/grid_planning.py`` can compare them:
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from typing import Literal
 
@@ -41,6 +42,7 @@ from seminspect.planning.grid_search import (
     search,
 )
 from seminspect.planning.gridmap import CostGrid, CostModel
+from seminspect.planning.smoothing import path_length, refine_path
 
 Engine = Literal["astar", "dijkstra", "mcp", "csgraph"]
 ENGINES: tuple[str, ...] = ("astar", "dijkstra", "mcp", "csgraph")
@@ -83,14 +85,24 @@ class VolumetricPlanner:
             self._graph = grid_graph(self.grid)
         self.build_time = time.perf_counter() - t0
 
-    def plan(self, start: ArrayLike, goal: ArrayLike, goal_radius: float = 0.0) -> GridPath:
+    def plan(
+        self,
+        start: ArrayLike,
+        goal: ArrayLike,
+        goal_radius: float = 0.0,
+        start_tolerance: float = 0.0,
+    ) -> GridPath:
         """Shortest path from ``start`` to ``goal`` (or to any free cell within ``goal_radius``).
+
+        A start that is blocked (a robot standing closer to an obstacle than the inflation, as
+        happens on a coarse map) begins from the nearest traversable cell within
+        ``start_tolerance``.
 
         Raises:
             PlanningError: start or goal outside the map or blocked, or no route exists.
         """
         t0 = time.perf_counter()
-        query = make_query(self.grid, start, goal, goal_radius)
+        query = make_query(self.grid, start, goal, goal_radius, start_tolerance)
         if self.engine == "mcp":
             return self._plan_mcp(query, t0)
         if self.engine == "csgraph":
@@ -138,6 +150,51 @@ class VolumetricPlanner:
             expansions=searched,
             engine="csgraph",
             started=t0,
+        )
+
+
+class RebuildingVolumetricPlanner:
+    """The volumetric baseline inside a mission (000 Sec VII-D's "FLIE + 3DLSG + D*+").
+
+    Every query takes the robot's current map, coarsens it to the baseline's ``resolution``
+    (0.4 m in the paper) when it is finer, rebuilds the whole cost grid (inflation, risk band,
+    unknown space at a cost) and runs the optimal A*, then drops the grid route's collinear points
+    and takes straight shortcuts on the same grid, as the paper's D*+ smooths its route with a
+    spline. ``planning_time`` counts the grid build, the search and the shortcuts; coarsening
+    stands in for the baseline's own map, which it would maintain anyway, and is not counted.
+    It answers the mission's navigator like :class:`~seminspect.planning.local.LocalPlanner`.
+    """
+
+    def __init__(
+        self,
+        model: CostModel,
+        band: tuple[float, float] | None,
+        resolution: float = 0.4,
+        start_tolerance: float | None = None,
+    ) -> None:
+        self.model = model
+        self.band = band
+        self.resolution = float(resolution)
+        self.start_tolerance = model.robot_radius if start_tolerance is None else start_tolerance
+
+    def plan(
+        self, voxel_map: VoxelMap, start: ArrayLike, goal: ArrayLike, goal_radius: float = 0.0
+    ) -> GridPath:
+        coarse = (
+            voxel_map
+            if voxel_map.resolution >= self.resolution
+            else voxel_map.coarsened(self.resolution)
+        )
+        t0 = time.perf_counter()
+        planner = VolumetricPlanner(coarse, self.model, self.band)
+        raw = planner.plan(start, goal, goal_radius, self.start_tolerance)
+        refined = refine_path(raw.waypoints, planner.grid).waypoints
+        return dataclasses.replace(
+            raw,
+            waypoints=refined,
+            length=path_length(refined),
+            planning_time=time.perf_counter() - t0,
+            engine="volumetric-rebuilt",
         )
 
 

@@ -14,31 +14,13 @@ from pathlib import Path
 
 import numpy as np
 
-from seminspect.core.errors import FileFormatError
-from seminspect.core.io import read_versioned_json
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.io import load_graph
-from seminspect.missions.rundir import CONFIG_FORMAT
+from seminspect.missions.rundir import load_run_world, load_trajectory
 from seminspect.report.figures import new_figure, save_figure
 from seminspect.report.lsg import draw_layers
 from seminspect.report.worlds import draw_top_down
-from seminspect.worlds import World, generate_world
-
-
-def load_run_world(run_dir: Path) -> World:
-    """Regenerate the world a run used (worlds are deterministic under their seed)."""
-    config = read_versioned_json(run_dir / "config.json", CONFIG_FORMAT, [1])["config"]
-    return generate_world(config["world"], config["scenario"], seed=config["seed"])
-
-
-def load_trajectory(run_dir: Path) -> np.ndarray:
-    path = run_dir / "trajectory.csv"
-    if not path.exists():
-        return np.empty((0, 9))
-    try:
-        return np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-    except ValueError as exc:
-        raise FileFormatError(f"{path}: {exc}") from None
+from seminspect.worlds import World
 
 
 def load_events(run_dir: Path) -> list[dict]:

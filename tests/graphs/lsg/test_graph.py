@@ -219,3 +219,14 @@ def test_the_polygon_can_come_from_a_later_level() -> None:
         graph.finish_inspection(polygon_level=2)
     building = graph.finish_inspection(polygon_level=1)
     np.testing.assert_allclose(building.position, [10.0, 0.0, 3.0])
+
+
+def test_edge_paths_run_through_entry_levels_and_via_points() -> None:
+    graph = small_graph()
+    graph.begin_inspection("truck-1", Observation.view_pose([0.0, 17.0, 0.7]))
+    graph.register_pose(Observation.view_pose([3.0, 20.0, 0.7]))
+    graph.finish_inspection()
+    edge = graph.connect_targets("truck-1", "car-0", via=[[0.0, 0.0, 0.7]])
+    np.testing.assert_allclose(graph.edge_path(edge), [[7, 0, 0.7], [0, 0, 0.7], [0, 17, 0.7]])
+    ring = graph.edge("car-0/Level-0/pose-3", "car-0/Level-0")
+    np.testing.assert_allclose(graph.edge_path(ring), [[7, 0, 0.7], [7, 0, 0.7]])

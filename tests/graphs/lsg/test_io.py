@@ -5,7 +5,7 @@ import networkx as nx
 import pytest
 from hypothesis import HealthCheck, given, settings
 
-from lsg_strategies import layered_graphs
+from lsg_strategies import climbing_graphs, layered_graphs
 from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.io import (
@@ -142,3 +142,20 @@ def test_spark_dsg_export_loads_in_spark_dsg(tmp_path: Path) -> None:
     assert set(loaded.layer_names) == {"targets", "levels", "poses", "features"}
     names = {loaded.get_layer(name).num_nodes() for name in ("levels",)}
     assert names == {3 * 2}
+
+
+@settings(
+    max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(graph=climbing_graphs())
+def test_open_rings_and_realised_level_edges_survive_a_round_trip(
+    tmp_path: Path, graph: LayeredSemanticGraph
+) -> None:
+    loaded = load_graph(save_graph(graph, tmp_path / "graph.json"))
+    assert edge_table(loaded) == edge_table(graph)
+    assert graph_document(loaded) == graph_document(graph)
+
+
+def test_a_graph_without_open_rings_or_level_routes_is_written_as_before(saved: dict) -> None:
+    levels = [level for target in saved["targets"] for level in target["levels"]]
+    assert levels and all("ring" not in level and "via" not in level for level in levels)

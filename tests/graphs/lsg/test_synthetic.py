@@ -1,5 +1,7 @@
+import numpy as np
+
 from seminspect.graphs.lsg.io import graph_document
-from seminspect.graphs.lsg.synthetic import synthetic_graph
+from seminspect.graphs.lsg.synthetic import VEHICLE_SIZE, synthetic_graph, synthetic_layout
 
 
 def test_synthetic_graphs_are_complete_and_deterministic() -> None:
@@ -14,3 +16,14 @@ def test_synthetic_graphs_are_complete_and_deterministic() -> None:
     assert graph_document(graph) != graph_document(
         synthetic_graph(7, seed=4, poses_per_level=5, levels=2)
     )
+
+
+def test_the_layout_is_where_the_graph_put_its_vehicles() -> None:
+    graph = synthetic_graph(9, seed=2, poses_per_level=6)
+    centres, labels = synthetic_layout(9, seed=2)
+    assert [t.label for t in graph.targets()] == labels
+    for target, centre, label in zip(graph.targets(), centres, labels, strict=True):
+        half_length, half_width, _ = VEHICLE_SIZE[label]
+        ring = np.array([p.position for p in target.levels[0].poses])
+        distance = np.linalg.norm(ring[:, :2] - centre[:2], axis=1)
+        np.testing.assert_allclose(distance, np.hypot(half_length, half_width) + 2.5)

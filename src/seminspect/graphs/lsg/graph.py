@@ -337,26 +337,18 @@ class LayeredSemanticGraph:
                 raise InvalidInputError(f"{node.id} is not inspected; only v_I - v_I edges exist")
         if first is second:
             raise InvalidInputError(f"cannot connect {first.id} to itself")
-        inner = (
-            np.empty((0, 3)) if via is None else np.asarray(via, dtype=np.float64).reshape(-1, 3)
-        )
-        if not np.all(np.isfinite(inner)):
-            raise InvalidInputError("via points must be finite")
-        if first.id > second.id:  # orient along the canonical key, so the sum is reproducible
-            first, second, inner = second, first, inner[::-1]
-        start, end = self.entry_level(first).position, self.entry_level(second).position
-        polyline = np.vstack([start, inner, end])
-        weight = float(np.linalg.norm(np.diff(polyline, axis=0), axis=1).sum())
-        edge = self._connect(
-            self.target_graph,
-            first,
-            second,
-            EdgeKind.SPATIAL,
-            weight=weight,
-            via=inner if len(inner) else None,
-        )
+        ends = (self.entry_level(first).position, self.entry_level(second).position)
+        edge = self._link(self.target_graph, first, second, via, ends)
         self.revision += 1
         return edge
+
+    def edge_path(self, edge: Edge) -> NDArray[np.float64]:
+        """The polyline (K x 3) realising a spatial edge from ``edge.u`` to ``edge.v``: the two
+        nodes (for ``v_I - v_I`` edges, the targets' ``Level-0``) and any via points between."""
+        ends = [self.node(edge.u), self.node(edge.v)]
+        a, b = (self.entry_level(n) if isinstance(n, TargetNode) else n for n in ends)
+        inner = edge.via if edge.via is not None else np.empty((0, 3))
+        return np.vstack([a.position, inner, b.position])
 
     @staticmethod
     def entry_level(target: TargetNode) -> LevelNode:
@@ -379,15 +371,21 @@ class LayeredSemanticGraph:
         self._inspection = _Inspection(target, level)
         return level
 
-    def begin_level(self, z: Observation) -> LevelNode:
-        """Close the current level (eq (10)) and start the next one at ``z`` (eq (7))."""
+    def begin_level(self, z: Observation, via: ArrayLike | None = None) -> LevelNode:
+        """Close the current level (eq (10)) and start the next one at ``z`` (eq (7)).
+
+        The spatial edge from the previous level is realised through ``via`` (M x 3, e.g. the
+        route the robot took to the new level's start) when given.
+        """
         inspection = self._require_inspection()
         self.close_level()
-        level = self._new_level(inspection.target, z)
+        level = self._new_level(inspection.target, z, via)
         inspection.level = level
         return level
 
-    def _new_level(self, target: TargetNode, z: Observation) -> LevelNode:
+    def _new_level(
+        self, target: TargetNode, z: Observation, via: ArrayLike | None = None
+    ) -> LevelNode:
         assert target.level_graph is not None
         previous = target.levels[-1] if target.levels else None
         index = len(target.levels)
@@ -403,7 +401,7 @@ class LayeredSemanticGraph:
         self._add_to(target.level_graph, level)
         self._connect(target.level_graph, target, level, EdgeKind.SYMBOLIC)
         if previous is not None:
-            self._connect(target.level_graph, previous, level, EdgeKind.SPATIAL)
+            self._link(target.level_graph, previous, level, via)
         self.revision += 1
         return level
 
@@ -445,18 +443,20 @@ class LayeredSemanticGraph:
             raise unknown_name("pose of the current level", pose_id, (p.id for p in poses))
         inspection.interim.append(PoseFeaturePair(pose_id, z))
 
-    def close_level(self) -> LevelSummary:
+    def close_level(self, close_ring: bool = True) -> LevelSummary:
         """End the current level: link its last pose back to it and apply eq (10).
 
         The kept features are named (see :mod:`naming`), attached to the Feature graph of
-        their best pose and merged into the unified graph.
+        their best pose and merged into the unified graph. ``close_ring=False`` leaves out the
+        edge from the last pose back to the level, for a caller that knows the robot cannot
+        drive it straight (the edge is a straight segment the robot never drove).
         """
         inspection = self._require_inspection()
         level = inspection.level
         if level.closed:
             return LevelSummary(level.id, 0, ())
         poses = level.poses
-        if len(poses) > 1:
+        if len(poses) > 1 and close_ring:
             self._connect(level.pose_graph, poses[-1], level, EdgeKind.SPATIAL)
         kept = optimise_features(inspection.interim, self.params.d_check_F)
         pose_order = {p.id: p.index for p in poses}
@@ -582,6 +582,31 @@ class LayeredSemanticGraph:
             raise InvalidInputError(f"node id {node.id!r} already exists")
         local.nodes[node.id] = node
         self._nodes[node.id] = node
+
+    def _link(
+        self,
+        local: LocalGraph,
+        a: Node,
+        b: Node,
+        via: ArrayLike | None,
+        ends: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
+    ) -> Edge:
+        """A spatial edge realised by the polyline ``ends[0]``, ``via``, ``ends[1]`` (the two
+        nodes' positions by default), weighing its length: the Euclidean distance when there is
+        no ``via``. ``via`` is stored oriented along the edge's canonical key."""
+        start, end = ends if ends is not None else (a.position, b.position)
+        inner = (
+            np.empty((0, 3)) if via is None else np.asarray(via, dtype=np.float64).reshape(-1, 3)
+        )
+        if not np.all(np.isfinite(inner)):
+            raise InvalidInputError("via points must be finite")
+        if a.id > b.id:  # orient along the canonical key, so the sum is reproducible
+            a, b, start, end, inner = b, a, end, start, inner[::-1]
+        polyline = np.vstack([start, inner, end])
+        weight = float(np.linalg.norm(np.diff(polyline, axis=0), axis=1).sum())
+        return self._connect(
+            local, a, b, EdgeKind.SPATIAL, weight=weight, via=inner if len(inner) else None
+        )
 
     def _connect(
         self,

@@ -89,6 +89,11 @@ class LevelRecord(_Record):
     position: Vec3
     stamp: float = 0.0
     poses: Annotated[list[PoseRecord], Field(max_length=MAX_ITEMS)] = []
+    #: Whether the last pose links back to the level (left out when the robot could not
+    #: drive it straight); written only when False.
+    ring: bool = True
+    #: Realisation of the edge from the previous level, oriented from it to this one.
+    via: Annotated[list[Vec3], Field(max_length=MAX_ITEMS)] | None = None
 
 
 class TargetRecord(_Record):
@@ -145,14 +150,15 @@ def graph_document(graph: LayeredSemanticGraph) -> dict[str, Any]:
             "stamp": graph.robot.stamp,
         },
         "next_target_index": graph.next_target_index,
-        "targets": [_target_record(t) for t in graph.targets()],
+        "targets": [_target_record(graph, t) for t in graph.targets()],
         "target_edges": [
             {"a": e.u, "b": e.v, "via": None if e.via is None else e.via.tolist()} for e in spatial
         ],
     }
 
 
-def _target_record(target: TargetNode) -> dict[str, Any]:
+def _target_record(graph: LayeredSemanticGraph, target: TargetNode) -> dict[str, Any]:
+    levels = target.levels
     return {
         "name": target.id,
         "index": target.index,
@@ -167,15 +173,29 @@ def _target_record(target: TargetNode) -> dict[str, Any]:
         "observations": target.observations,
         "polygon": None if target.polygon is None else target.polygon.tolist(),
         "levels": [
-            {
-                "name": level.name,
-                "position": level.position.tolist(),
-                "stamp": level.stamp,
-                "poses": [_pose_record(pose) for pose in level.poses],
-            }
-            for level in target.levels
+            _level_record(graph, level, levels[i - 1] if i else None)
+            for i, level in enumerate(levels)
         ],
     }
+
+
+def _level_record(
+    graph: LayeredSemanticGraph, level: LevelNode, previous: LevelNode | None
+) -> dict[str, Any]:
+    record: dict[str, Any] = {
+        "name": level.name,
+        "position": level.position.tolist(),
+        "stamp": level.stamp,
+        "poses": [_pose_record(pose) for pose in level.poses],
+    }
+    poses = level.poses
+    if len(poses) > 1 and graph.edge(poses[-1].id, level.id) is None:
+        record["ring"] = False
+    link = None if previous is None else graph.edge(previous.id, level.id)
+    if link is not None and link.via is not None:  # kept along the edge's key, written forward
+        forward = previous is not None and link.u == previous.id
+        record["via"] = (link.via if forward else link.via[::-1]).tolist()
+    return record
 
 
 def _pose_record(pose: PoseNode) -> dict[str, Any]:
@@ -293,11 +313,13 @@ def _restore_level(
     graph._add_to(target.level_graph, level)
     graph._connect(target.level_graph, target, level, EdgeKind.SYMBOLIC)
     if previous is not None:
-        graph._connect(target.level_graph, previous, level, EdgeKind.SPATIAL)
+        graph._link(target.level_graph, previous, level, record.via)
+    elif record.via is not None:
+        raise InvalidInputError(f"{level.id} is the first level; it has no edge to realise")
     before: LevelNode | PoseNode = level
     for pose_index, pose_record in enumerate(record.poses):
         before = _restore_pose(graph, level, pose_index, pose_record, before)
-    if len(record.poses) > 1:
+    if len(record.poses) > 1 and record.ring:
         graph._connect(level.pose_graph, before, level, EdgeKind.SPATIAL)
     return level
 

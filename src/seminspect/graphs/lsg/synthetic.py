@@ -21,8 +21,8 @@ from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.perception.observation import Observation
 
-#: Half-lengths, half-widths and heights (m) of the synthetic vehicles.
-_SIZE = {"car": (2.3, 0.95, 1.5), "truck": (4.0, 1.25, 3.2)}
+#: Half-lengths (along x), half-widths (along y) and heights (m) of the synthetic vehicles.
+VEHICLE_SIZE = {"car": (2.3, 0.95, 1.5), "truck": (4.0, 1.25, 3.2)}
 
 
 def synthetic_graph(
@@ -39,7 +39,7 @@ def synthetic_graph(
     """A fully inspected graph of ``n_targets`` vehicles (see the module docstring)."""
     rng = make_rng(seed, "synthetic-lsg")
     params = params or PRESETS["urban-simulated"]
-    centres, labels = _layout(n_targets, spacing, rng)
+    centres, labels = _layout(n_targets, spacing, rng)  # the stream's first draws
     graph = LayeredSemanticGraph(params, robot_position=(0.0, 0.0, 0.0))
     for centre, label in zip(centres, labels, strict=True):
         graph.register_target(
@@ -80,6 +80,14 @@ def synthetic_graph(
         inspected.append(k)
         tree_points.append(centres[k][:2])
     return graph
+
+
+def synthetic_layout(
+    n_targets: int, *, seed: int = 0, spacing: float = 18.0
+) -> tuple[np.ndarray, list[str]]:
+    """The vehicle centres (N x 3, 0.75 m up) and labels that :func:`synthetic_graph` places for
+    the same arguments: the layout is the first thing drawn from its random stream."""
+    return _layout(n_targets, spacing, make_rng(seed, "synthetic-lsg"))
 
 
 def _layout(n: int, spacing: float, rng: np.random.Generator) -> tuple[np.ndarray, list[str]]:
@@ -124,7 +132,7 @@ def _inspect(
     levels: int,
     parts_per_pose: int,
 ) -> None:
-    half_length, half_width, height = _SIZE[label]
+    half_length, half_width, height = VEHICLE_SIZE[label]
     radius = math.hypot(half_length, half_width) + 2.5
     start_angle = float(rng.uniform(0, math.tau))
     for level in range(levels):
