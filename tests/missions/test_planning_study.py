@@ -139,6 +139,29 @@ def test_a_run_is_compared_query_by_query(small_mission_dir: Path) -> None:
         assert math.isfinite(q.time_ratio(0.5, "query")) and q.hp.repeats == 3
 
 
+def test_the_full_volume_baseline_searches_every_height(small_mission_dir: Path) -> None:
+    args = {"count": 2, "repeats": 1, "vp_repeats": 1, "resolutions": (0.5,)}
+    ground = compare_run(small_mission_dir, **args)
+    full = compare_run(small_mission_dir, volume="full", **args)
+    assert ground.volume == "ground" and full.volume == "full"
+    for flat, free in zip(ground.queries, full.queries, strict=True):
+        assert flat.query == free.query and flat.hp_length_m == free.hp_length_m
+        answer, check = free.volumetric(0.5), free.vp_checks[0]
+        assert answer.error is None and check.segments == len(answer.waypoints) - 1
+        # A 0.5 m grid keeps its clearance from cell centres: now and then a cell's worth short.
+        assert check.valid >= 0.9 * check.segments
+        # It flies no lower than the robot's centre, and up to where the map ends.
+        assert answer.waypoints[:, 2].min() >= full.start[2] - 1e-6
+    assert sum(q.vp_checks[0].segments for q in full.queries) > 10
+
+
+def test_an_unknown_volume_is_refused(small_mission_dir: Path) -> None:
+    with pytest.raises(InvalidInputError, match="unknown volume 'sky'"):
+        compare_run(small_mission_dir, volume="sky")
+    with pytest.raises(InvalidInputError, match="unknown volume 'sky'"):
+        planning_study.run_study(["small"], small_mission_dir.parent, volume="sky")
+
+
 def test_mission_outcomes_are_read_from_the_metrics(small_mission_dir: Path) -> None:
     outcome = MissionOutcome.read(small_mission_dir, "small", "hierarchical")
     assert outcome.inspected >= 3 and outcome.sim_time_s > 0 and outcome.planning_wall_s > 0

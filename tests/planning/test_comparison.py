@@ -8,7 +8,12 @@ import pytest
 from seminspect.core.errors import InvalidInputError
 from seminspect.graphs.lsg.synthetic import synthetic_graph
 from seminspect.mapping.voxel import FREE, OCCUPIED, VoxelMap
-from seminspect.planning.comparison import segment_validity, time_hierarchical, time_volumetric
+from seminspect.planning.comparison import (
+    fine_segment_validity,
+    segment_validity,
+    time_hierarchical,
+    time_volumetric,
+)
 from seminspect.planning.gridmap import CostModel
 from seminspect.planning.hierarchical import HierarchicalPlanner
 from seminspect.planning.scaling import box_city, growth_exponent, scaling_point
@@ -86,3 +91,16 @@ def test_growth_exponent_recovers_a_power_law() -> None:
         growth_exponent([20], [1.0])
     with pytest.raises(InvalidInputError):
         growth_exponent([20, 200], [1.0, float("nan")])
+
+
+def test_the_fine_check_sees_what_a_flying_body_would_touch() -> None:
+    world = box_world()  # a crate over x 4..6, y -1..1, 2 m tall, on the ground
+    over = [[3.0, 0.0, 2.6], [7.0, 0.0, 2.6]]  # 0.6 m over the lid
+    low = [[-8.0, 3.0, 0.35], [-4.0, 3.0, 0.35]]  # 0.35 m over open ground
+    assert fine_segment_validity(world, over, 0.4).tolist() == [True]
+    assert fine_segment_validity(world, low, 0.4).tolist() == [False]
+    assert fine_segment_validity(world, np.add(low, [0, 0, 0.2]), 0.4).tolist() == [True]
+    through = [[2.0, 0.0, 1.0], [8.0, 0.0, 1.0], [8.0, 4.0, 1.0]]  # across the crate, then clear
+    assert fine_segment_validity(world, through, 0.4).tolist() == [False, True]
+    # The coarse aerial grid cannot tell: it turns down the clear segment low over the ground.
+    assert not segment_validity(world, np.add(low, [0, 0, 0.2]), 0.4, "aerial").all()

@@ -15,6 +15,11 @@ app = typer.Typer(no_args_is_help=True)
 DEFAULT_SIZES = [20, 50, 100, 200, 500, 1000, 2000]
 
 
+class VolumeChoice(str, Enum):
+    ground = "ground"
+    full = "full"
+
+
 class ScenarioChoice(str, Enum):
     small = "small"
     medium = "medium"
@@ -42,6 +47,12 @@ def planning(
     scaling: bool = typer.Option(True, "--scaling/--no-scaling", help="Run the scaling study."),
     missions: bool = typer.Option(
         True, "--missions/--no-missions", help="Run the Table 6 mission comparison."
+    ),
+    volume: VolumeChoice = typer.Option(
+        VolumeChoice.ground,
+        "--volume",
+        help="What the volumetric baseline searches: the robot's height band (ground) or the "
+        "map's whole height (full, as the paper's aerial D*+).",
     ),
 ) -> None:
     """Hierarchical versus volumetric planning: 000 Table 5, Fig 13 and Table 6 analogues.
@@ -85,6 +96,7 @@ def planning(
             queries=queries,
             sizes=sizes,
             missions=missions,
+            volume=volume.value,
             progress=show,
         )
     written = write_study(study, out)

@@ -50,6 +50,7 @@ from seminspect.missions.xflie import PLANNING_MARGIN, MissionProgress
 from seminspect.planning.comparison import (
     HierarchicalTiming,
     VolumetricResult,
+    fine_segment_validity,
     segment_validity,
     time_hierarchical,
     time_volumetric,
@@ -64,6 +65,10 @@ from seminspect.worlds import World
 CITY_SCENARIOS = ("small", "medium", "large")
 #: Volumetric map resolutions: 000 Table 5's 0.5 and 0.7 m, and Table 6's 0.4 m [m].
 RESOLUTIONS = (0.4, 0.5, 0.7)
+#: Volumes the volumetric baseline may search: ``ground``, the robot's own height band
+#: (8-connected, what a ground robot can drive); ``full``, every height of the map (26-connected,
+#: as 000's D*+ searched the OctoMap of its simulated aerial robot).
+VOLUMES = ("ground", "full")
 #: Parts the paper's Table 5 queries name; a target's query asks for the first one it has.
 PREFERRED_FEATURES = ("front-bumper", "back-left-door", "front-glass", "trunk", "front-right-door")
 
@@ -232,8 +237,14 @@ class PathCheck:
     segments: int
 
     @classmethod
-    def of(cls, world: World, waypoints: ArrayLike, radius: float) -> PathCheck:
-        free = segment_validity(world, waypoints, radius)
+    def of(
+        cls, world: World, waypoints: ArrayLike, radius: float, volume: str = "ground"
+    ) -> PathCheck:
+        """Check a path driven on the ground, or flown through the whole ``volume``."""
+        if volume == "ground":
+            free = segment_validity(world, waypoints, radius, "ground")
+        else:
+            free = fine_segment_validity(world, waypoints, radius)
         return cls(int(free.sum()), len(free))
 
     @property
@@ -298,6 +309,8 @@ class RunComparison:
     repeats: int
     vp_repeats: int
     queries: list[QueryComparison] = field(default_factory=list)
+    #: The volume the volumetric baseline searched (one of :data:`VOLUMES`).
+    volume: str = "ground"
 
 
 @dataclass
@@ -311,6 +324,8 @@ class _Setting:
     #: The robot's final map as its planners see it (clearance with the mission's margin).
     robot_grid: CostGrid
     planners: dict[float, VolumetricPlanner]
+    #: The volume the volumetric baseline searches (one of :data:`VOLUMES`).
+    volume: str
 
 
 def reachable_targets(planner: HierarchicalPlanner, start: NDArray[np.float64]) -> set[str]:
@@ -344,27 +359,47 @@ def final_pose(run_dir: Path) -> NDArray[np.float64]:
     return trajectory[-1, 5:8].copy()
 
 
-def _setting(run_dir: Path, resolutions: Sequence[float]) -> tuple[_Setting, dict[float, float]]:
+def _setting(
+    run_dir: Path, resolutions: Sequence[float], volume: str
+) -> tuple[_Setting, dict[float, float]]:
     config = read_run_config(run_dir)
     world = load_run_world(run_dir)
     radius = float(config["robot"]["radius"])
     band = MissionConfig.model_validate(config).robot.planning_band()
     robot_map: VoxelMap = load_map(run_dir / MAP_FILE)
     own = CostModel(radius + PLANNING_MARGIN, risk_radius=0.0, unknown_cost=None)
+    start = final_pose(run_dir)
     planners, build = {}, {}
     for resolution in resolutions:
-        known = VoxelMap.from_world(world, resolution)
-        planner = VolumetricPlanner(known, CostModel(radius), band=above_ground(band, known))
+        if volume == "ground":
+            known = VoxelMap.from_world(world, resolution)
+            vp_band: tuple[float, float] | None = above_ground(band, known)
+        else:
+            known = VoxelMap.from_world(world, resolution, flight_box(world, resolution, start[2]))
+            vp_band = None
+        planner = VolumetricPlanner(known, CostModel(radius), band=vp_band)
         planners[resolution], build[resolution] = planner, planner.build_time
     setting = _Setting(
         world=world,
         graph=load_graph(run_dir / "graph.json"),
-        start=final_pose(run_dir),
+        start=start,
         radius=radius,
         robot_grid=CostGrid.build(robot_map, own, band),
         planners=planners,
+        volume=volume,
     )
     return setting, build
+
+
+def flight_box(world: World, resolution: float, floor: float) -> NDArray[np.float64]:
+    """The world's box from the height ``floor`` up, its bottom layer of cells centred there.
+
+    The full-volume baseline flies no lower than the robot's own centre: one layer lower, a
+    body of the robot's radius would graze the ground in a coarse map.
+    """
+    box = np.array(world.bounds, dtype=np.float64)
+    box[0, 2] = floor - 0.5 * resolution
+    return box
 
 
 def above_ground(band: tuple[float, float], known: VoxelMap) -> tuple[float, float]:
@@ -380,11 +415,14 @@ def compare_run(
     repeats: int = 200,
     vp_repeats: int = 3,
     resolutions: Sequence[float] = RESOLUTIONS,
+    volume: str = "ground",
     progress: Callable[[str], None] | None = None,
 ) -> RunComparison:
-    """Select ``count`` queries on a run's final graph and answer each with both planners."""
+    """Select ``count`` queries on a run's final graph and answer each with both planners,
+    the volumetric one searching ``volume`` (one of :data:`VOLUMES`)."""
+    _check_volume(volume)
     root = Path(run_dir)
-    setting, build = _setting(root, resolutions)
+    setting, build = _setting(root, resolutions, volume)
     planner = HierarchicalPlanner(setting.graph)
     refine_path(setting.graph.robot.position[None].repeat(2, 0), setting.robot_grid)  # warm up
     reachable = reachable_targets(planner, setting.start)
@@ -406,6 +444,7 @@ def compare_run(
         repeats=repeats,
         vp_repeats=vp_repeats,
         queries=comparisons,
+        volume=volume,
     )
 
 
@@ -430,7 +469,10 @@ def _compare(
         refine_s=statistics.median(r.refine_time for r in refinements),
         refined_check=PathCheck.of(setting.world, refined.waypoints, setting.radius),
         vp=answers,
-        vp_checks=tuple(PathCheck.of(setting.world, a.waypoints, setting.radius) for a in answers),
+        vp_checks=tuple(
+            PathCheck.of(setting.world, a.waypoints, setting.radius, setting.volume)
+            for a in answers
+        ),
     )
 
 
@@ -512,16 +554,19 @@ def run_study(
     queries: int = 9,
     sizes: Sequence[int] = SCALING_SIZES,
     missions: bool = True,
+    volume: str = "ground",
     progress: StudyProgress | None = None,
 ) -> PlanningStudy:
-    """The Table 5 comparison on each scenario's mission, the scaling study over ``sizes``
-    (none when empty) and, with ``missions``, the Table 6 mission comparison."""
+    """The Table 5 comparison on each scenario's mission (the volumetric baseline searching
+    ``volume``), the scaling study over ``sizes`` (none when empty) and, with ``missions``, the
+    Table 6 mission comparison."""
+    _check_volume(volume)
     table5 = []
     for scenario in scenarios:
         label = f"Table 5 mission: {scenario}"
         run_dir = ensure_run(study_config(scenario), runs_dir, _mission_progress(progress, label))
         step = None if progress is None else (lambda text: progress(f"query: {text}", None))
-        table5.append(compare_run(run_dir, count=queries, progress=step))
+        table5.append(compare_run(run_dir, count=queries, volume=volume, progress=step))
     scaling = (
         scaling_study(
             sizes, progress=None if progress is None else lambda n: progress(f"scaling: {n}", None)
@@ -531,6 +576,11 @@ def run_study(
     )
     table6 = mission_study(scenarios, runs_dir, progress) if missions else []
     return PlanningStudy(table5, scaling, table6)
+
+
+def _check_volume(volume: str) -> None:
+    if volume not in VOLUMES:
+        raise InvalidInputError(f"unknown volume {volume!r}; choose from {', '.join(VOLUMES)}")
 
 
 def _mission_progress(

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from seminspect.core.errors import InvalidInputError, PlanningError
+from seminspect.geometry.raster import cells_touching_triangles
 from seminspect.geometry.transforms import as_points
 from seminspect.planning.hierarchical import RoutePlan
 from seminspect.planning.volumetric import VolumetricPlanner
@@ -27,6 +28,10 @@ from seminspect.worlds import CollisionMode, World
 
 #: How far (in cells) a blocked start or goal may move to a traversable cell.
 END_TOLERANCE_CELLS = 2.0
+#: Cell size of the fine check of paths through the whole volume [m].
+FINE_CHECK_RESOLUTION = 0.05
+#: Longest piece of a segment the fine check rasterises the world around at once [m].
+FINE_CHECK_PIECE = 1.0
 
 
 @dataclass(frozen=True)
@@ -130,6 +135,65 @@ def segment_validity(
         [world.segment_is_free(a, b, radius, mode) for a, b in pairwise(points)],
         dtype=bool,
     )
+
+
+def fine_segment_validity(
+    world: World, waypoints: ArrayLike, radius: float, resolution: float = FINE_CHECK_RESOLUTION
+) -> NDArray[np.bool_]:
+    """Whether a sphere of ``radius`` sweeps each segment without touching the world, for paths
+    through the whole volume: over objects, or close above the ground.
+
+    The world's 3D collision grid may underestimate clearance by 0.69 m in the city, too much to
+    judge a body flying 0.3 m above the ground. Here each segment, in pieces of at most
+    :data:`FINE_CHECK_PIECE`, is checked against the cells of a fine grid around the piece that
+    the surface touches: the surface lies within half a cell diagonal of such a cell's centre,
+    so the piece is free when every centre keeps ``radius`` plus that half diagonal from it.
+    (A path from free space cannot reach the inside of a solid without crossing its surface.)
+    """
+    points = as_points(waypoints, "waypoints", allow_empty=True)
+    check = _FineCheck(world.triangles, radius, resolution)
+    return np.array(
+        [
+            all(check.piece_is_free(a + s * (b - a), a + t * (b - a)) for s, t in _pieces(a, b))
+            for a, b in pairwise(points)
+        ],
+        dtype=bool,
+    )
+
+
+def _pieces(a: NDArray[np.float64], b: NDArray[np.float64]) -> list[tuple[float, float]]:
+    count = max(1, math.ceil(float(np.linalg.norm(b - a)) / FINE_CHECK_PIECE))
+    return list(pairwise(np.linspace(0.0, 1.0, count + 1)))
+
+
+class _FineCheck:
+    """Clearance of short segments from the world's surface, on a fine grid around each."""
+
+    def __init__(self, triangles: NDArray[np.float64], radius: float, resolution: float) -> None:
+        self.triangles = triangles
+        self.low, self.high = triangles.min(axis=1), triangles.max(axis=1)
+        self.resolution = resolution
+        self.margin = radius + 2.0 * resolution
+        self.needed = radius + 0.5 * math.sqrt(3.0) * resolution
+
+    def piece_is_free(self, a: NDArray[np.float64], b: NDArray[np.float64]) -> bool:
+        lower, upper = np.minimum(a, b) - self.margin, np.maximum(a, b) + self.margin
+        near = np.all((self.low <= upper) & (self.high >= lower), axis=1)
+        if not near.any():
+            return True
+        shape = tuple(int(n) for n in np.ceil((upper - lower) / self.resolution))
+        touched = cells_touching_triangles(self.triangles[near], lower, self.resolution, shape)
+        centres = lower + (np.argwhere(touched) + 0.5) * self.resolution
+        return bool(_distance_to_segment(centres, a, b).min(initial=np.inf) >= self.needed)
+
+
+def _distance_to_segment(
+    points: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    ab = b - a
+    length2 = float(ab @ ab)
+    t = np.zeros(len(points)) if length2 == 0 else np.clip((points - a) @ ab / length2, 0.0, 1.0)
+    return np.linalg.norm(points - (a + t[:, None] * ab), axis=1)
 
 
 def _check_repeats(repeats: int) -> None:

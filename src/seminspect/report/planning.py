@@ -356,12 +356,21 @@ def targets_markdown(met: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _volume_phrase(study: PlanningStudy) -> str:
+    volumes = {run.volume for run in study.table5} or {"ground"}
+    phrases = {
+        "ground": "the robot's height band, 8-connected",
+        "full": "the map's whole height, 26-connected, as the paper's aerial D*+",
+    }
+    return "; ".join(phrases[v] for v in sorted(volumes))
+
+
 def study_markdown(study: PlanningStudy) -> str:
     parts = ["# Planning study: hierarchical (3DLSG) versus volumetric planning", ""]
     parts.append(
         f"Measured on this machine ({machine_line()}). HP = hierarchical planner, VP = "
-        "volumetric baseline (A*, ground band, robot radius 0.4 m, risk band 0.2 m); paper "
-        "numbers are 000's.\n"
+        f"volumetric baseline (A* over {_volume_phrase(study)}, robot radius 0.4 m, risk band "
+        "0.2 m); paper numbers are 000's.\n"
     )
     parts.append(targets_markdown(targets_met(study)))
     if study.table5:
@@ -436,6 +445,7 @@ def study_document(study: PlanningStudy) -> dict[str, Any]:
             {
                 "scenario": run.scenario,
                 "run_dir": str(run.run_dir),
+                "volume": run.volume,
                 "repeats": {"hierarchical": run.repeats, "volumetric": run.vp_repeats},
                 "graph_edge_check": dataclasses.asdict(run.edge_check),
                 "start": run.start.tolist(),
