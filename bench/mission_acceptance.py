@@ -10,6 +10,7 @@ The figures do not depend on the machine (simulated time drives the robot; every
 seeded); only the wall-clock columns do.
 
 Run: ``.venv/bin/python bench/mission_acceptance.py [--out runs/acceptance] [--json out.json]``
+(``--reuse`` reads completed runs of the same configuration instead of running them again).
 """
 
 from __future__ import annotations
@@ -18,8 +19,11 @@ import argparse
 import json
 from pathlib import Path
 
-from seminspect.missions.config import make_config
+from seminspect.core.io import read_versioned_json
+from seminspect.missions.config import make_config, resolve
+from seminspect.missions.planning_study import reusable_run
 from seminspect.missions.run import run_mission
+from seminspect.missions.rundir import METRICS_FORMAT
 
 CITY = [("city", scenario, seed) for scenario in ("small", "medium", "large") for seed in (0, 1, 2)]
 OTHERS = [
@@ -64,6 +68,9 @@ def main() -> None:
     parser.add_argument("--out", default="runs/acceptance", help="where the run directories go")
     parser.add_argument("--json", help="also write every run's metrics to this file")
     parser.add_argument("--city-only", action="store_true")
+    parser.add_argument(
+        "--reuse", action="store_true", help="read completed runs of the same config in --out"
+    )
     args = parser.parse_args()
     runs = CITY + ([] if args.city_only else OTHERS)
     print(
@@ -75,15 +82,19 @@ def main() -> None:
     results = []
     for world, scenario, seed in runs:
         name = f"{world}-{scenario or 'default'}-seed{seed}"
-        config = make_config({"world": world, "scenario": scenario, "seed": seed})
-        result = run_mission(config, Path(args.out) / name)
-        results.append({"world": world, "scenario": scenario, "seed": seed, **result.metrics})
-        print(row(world, scenario, seed, result.metrics), flush=True)
-    city = [r for r in results if r["world"] == "city"]
+        config = resolve(make_config({"world": world, "scenario": scenario, "seed": seed}))
+        out = Path(args.out) / name
+        if args.reuse and reusable_run(out, config):
+            metrics = read_versioned_json(out / "metrics.json", METRICS_FORMAT, [1])
+        else:
+            metrics = run_mission(config, out).metrics
+        results.append({**metrics, "run": {"world": world, "scenario": scenario, "seed": seed}})
+        print(row(world, scenario, seed, metrics), flush=True)
+    city = [r for r in results if r["run"]["world"] == "city"]
     print()
     print("City acceptance (issue 4): ")
     for scenario in ("small", "medium", "large"):
-        group = [r for r in city if r["scenario"] == scenario]
+        group = [r for r in city if r["run"]["scenario"] == scenario]
         detected = min(r["table3"]["detected_pct"] for r in group)
         inspected = min(r["table3"]["inspected_pct"] for r in group)
         rmse = max(r["table6"]["localisation_rmse_m"] or 0.0 for r in group)
