@@ -524,18 +524,19 @@ class LayeredSemanticGraph:
         return target
 
     def _prune_covered(self, target: TargetNode) -> tuple[str, ...]:
-        covered = []
-        for other in self.targets(TargetStatus.DETECTED):
-            near = np.linalg.norm(other.position - target.position) <= self.params.d_check_T
-            inside = (
-                target.polygon is not None
-                and polygon_contains(target.polygon, other.position[:2])[0]
-            )
-            if near or inside:
-                covered.append(other.id)
+        others = self.targets(TargetStatus.DETECTED)
+        if not others:
+            return ()
+        # One vectorised test over every detected target: a mission keeps few, but a graph
+        # built offline may hold thousands, and a test per target made that quadratic.
+        positions = np.array([other.position for other in others])
+        hits = np.linalg.norm(positions - target.position, axis=1) <= self.params.d_check_T
+        if target.polygon is not None:
+            hits |= polygon_contains(target.polygon, positions[:, :2])
+        covered = tuple(other.id for other, hit in zip(others, hits, strict=True) if hit)
         for target_id in covered:
             self.discard_target(target_id)
-        return tuple(covered)
+        return covered
 
     def abort_inspection(self) -> TargetNode | None:
         """End an inspection cut short: finish it with what was gathered when its first level
