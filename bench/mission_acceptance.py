@@ -19,11 +19,9 @@ import argparse
 import json
 from pathlib import Path
 
-from seminspect.core.io import read_versioned_json
 from seminspect.missions.config import make_config, resolve
-from seminspect.missions.planning_study import reusable_run
 from seminspect.missions.run import run_mission
-from seminspect.missions.rundir import METRICS_FORMAT
+from seminspect.missions.rundir import read_run_metrics, reusable_run
 
 CITY = [("city", scenario, seed) for scenario in ("small", "medium", "large") for seed in (0, 1, 2)]
 OTHERS = [
@@ -85,7 +83,7 @@ def main() -> None:
         config = resolve(make_config({"world": world, "scenario": scenario, "seed": seed}))
         out = Path(args.out) / name
         if args.reuse and reusable_run(out, config):
-            metrics = read_versioned_json(out / "metrics.json", METRICS_FORMAT, [1])
+            metrics = read_run_metrics(out)
         else:
             metrics = run_mission(config, out).metrics
         results.append({**metrics, "run": {"world": world, "scenario": scenario, "seed": seed}})

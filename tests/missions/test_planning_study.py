@@ -19,11 +19,10 @@ from seminspect.missions.planning_study import (
     compare_run,
     ensure_run,
     reachable_targets,
-    reusable_run,
     select_queries,
     study_config,
 )
-from seminspect.missions.rundir import RunDirectory
+from seminspect.missions.rundir import RunDirectory, reusable_run
 from seminspect.perception.observation import Observation
 from seminspect.planning.comparison import HierarchicalTiming, VolumetricResult
 from seminspect.planning.hierarchical import HierarchicalPlanner

@@ -31,7 +31,6 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from seminspect.core.errors import FileFormatError, InvalidInputError, PlanningError
-from seminspect.core.io import read_versioned_json
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.io import load_graph
 from seminspect.graphs.lsg.model import EdgeKind, FeatureNode, TargetNode, TargetStatus
@@ -40,11 +39,11 @@ from seminspect.missions.config import CITY_BUDGETS, MissionConfig, make_config,
 from seminspect.missions.run import run_mission, run_name
 from seminspect.missions.rundir import (
     MAP_FILE,
-    METRICS_FORMAT,
-    STATUS_FORMAT,
     load_run_world,
     load_trajectory,
     read_run_config,
+    read_run_metrics,
+    reusable_run,
 )
 from seminspect.missions.xflie import PLANNING_MARGIN, MissionProgress
 from seminspect.planning.comparison import (
@@ -158,16 +157,6 @@ def ensure_run(
         shutil.rmtree(out)  # an interrupted, failed or differently configured run of the study
     run_mission(config, out, progress=progress)
     return out
-
-
-def reusable_run(run_dir: Path, config: MissionConfig) -> bool:
-    """Whether ``run_dir`` holds a completed run of exactly ``config`` with its map."""
-    try:
-        status = read_versioned_json(run_dir / "status.json", STATUS_FORMAT, [1])
-        same = read_run_config(run_dir) == config.model_dump(mode="json")
-    except FileFormatError:
-        return False
-    return same and status.get("state") == "completed" and (run_dir / MAP_FILE).is_file()
 
 
 # ---------------------------------------------------------------------------- queries
@@ -498,7 +487,7 @@ class MissionOutcome:
 
     @classmethod
     def read(cls, run_dir: Path, scenario: str, planner: str) -> MissionOutcome:
-        metrics = read_versioned_json(run_dir / "metrics.json", METRICS_FORMAT, [1])
+        metrics = read_run_metrics(run_dir)
         t6, mission, targets = metrics["table6"], metrics["mission"], metrics["targets"]
         return cls(
             scenario=scenario,

@@ -26,7 +26,7 @@ import os
 import time
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import cv2
 import numpy as np
@@ -44,6 +44,9 @@ from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.io import save_graph
 from seminspect.mapping.voxel import VoxelMap, save_map
 from seminspect.worlds import World, generate_world
+
+if TYPE_CHECKING:
+    from seminspect.missions.config import MissionConfig
 
 STATUS_FORMAT = "seminspect.run-status"
 METRICS_FORMAT = "seminspect.run-metrics"
@@ -132,6 +135,21 @@ class RunDirectory:
 def read_run_config(run_dir: Path) -> dict[str, Any]:
     """The resolved mission configuration a run was made with."""
     return read_versioned_json(run_dir / "config.json", CONFIG_FORMAT, [1])["config"]
+
+
+def read_run_metrics(run_dir: Path) -> dict[str, Any]:
+    """The metrics a run wrote when it ended."""
+    return read_versioned_json(run_dir / "metrics.json", METRICS_FORMAT, [1])
+
+
+def reusable_run(run_dir: Path, config: MissionConfig) -> bool:
+    """Whether ``run_dir`` holds a completed run of exactly ``config`` with its map."""
+    try:
+        status = read_versioned_json(run_dir / "status.json", STATUS_FORMAT, [1])
+        same = read_run_config(run_dir) == config.model_dump(mode="json")
+    except FileFormatError:
+        return False
+    return same and status.get("state") == "completed" and (run_dir / MAP_FILE).is_file()
 
 
 def load_run_world(run_dir: Path) -> World:
