@@ -26,10 +26,9 @@ import networkx as nx
 import numpy as np
 
 from seminspect.graphs.lsg.convert import traversable_networkx
-from seminspect.graphs.lsg.graph import LayeredSemanticGraph
-from seminspect.graphs.lsg.model import FeatureNode
 from seminspect.graphs.lsg.synthetic import synthetic_graph
 from seminspect.planning.hierarchical import HierarchicalPlanner
+from seminspect.planning.scaling import random_queries
 from seminspect.planning.search import CsrGraph, shortest_path
 
 
@@ -39,20 +38,6 @@ def flat_csr(flat: nx.Graph) -> tuple[CsrGraph, dict[str, int]]:
     edges = [(index[a], index[b]) for a, b in flat.edges]
     weights = [w for _, _, w in flat.edges(data="weight")]
     return CsrGraph.from_edges(coords, edges, weights), index
-
-
-def make_queries(
-    graph: LayeredSemanticGraph, count: int, seed: int
-) -> list[tuple[np.ndarray, str]]:
-    rng = np.random.default_rng(seed)
-    features = [n for n in graph.nodes() if isinstance(n, FeatureNode)]
-    anchors = [p for t in graph.targets() for lv in t.levels for p in lv.poses]
-    queries = []
-    for _ in range(count):
-        anchor = anchors[rng.integers(len(anchors))].position
-        start = anchor + rng.normal(0.0, 1.0, 3) * [1, 1, 0]
-        queries.append((start, features[rng.integers(len(features))].id))
-    return queries
 
 
 def percentiles(seconds: list[float]) -> tuple[float, float]:
@@ -70,7 +55,7 @@ def run_size(n_targets: int, n_queries: int, nx_queries: int, seed: int) -> dict
     index_s = time.perf_counter() - t0
     flat = traversable_networkx(graph)
     csr, flat_index = flat_csr(flat)
-    queries = make_queries(graph, n_queries, seed + 1)
+    queries = random_queries(graph, n_queries, seed + 1)
 
     hier, target_layer, flat_kernel, nx_times, settled = [], [], [], [], []
     for k, (start, goal) in enumerate(queries):

@@ -104,3 +104,16 @@ def test_the_fine_check_sees_what_a_flying_body_would_touch() -> None:
     assert fine_segment_validity(world, through, 0.4).tolist() == [False, True]
     # The coarse aerial grid cannot tell: it turns down the clear segment low over the ground.
     assert not segment_validity(world, np.add(low, [0, 0, 0.2]), 0.4, "aerial").all()
+
+
+@pytest.mark.parametrize(
+    ("waypoints", "radius", "resolution", "message"),
+    [
+        ([[0, 0, 1], [1, 0, float("nan")]], 0.4, 0.05, "waypoints"),
+        ([[0, 0, 1], [1, 0, 1]], -0.4, 0.05, "radius"),
+        ([[0, 0, 1], [1, 0, 1]], 0.4, 0.0, "resolution"),
+    ],
+)
+def test_the_fine_check_refuses_impossible_input(waypoints, radius, resolution, message) -> None:
+    with pytest.raises(InvalidInputError, match=message):
+        fine_segment_validity(box_world(), waypoints, radius, resolution)

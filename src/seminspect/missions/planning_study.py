@@ -259,9 +259,16 @@ class QueryComparison:
     vp_checks: tuple[PathCheck, ...]
 
     def volumetric(self, resolution: float) -> VolumetricResult:
-        for result in self.vp:
+        return self.vp[self._vp_index(resolution)]
+
+    def vp_check(self, resolution: float) -> PathCheck:
+        """The world check of the volumetric path at ``resolution``."""
+        return self.vp_checks[self._vp_index(resolution)]
+
+    def _vp_index(self, resolution: float) -> int:
+        for index, result in enumerate(self.vp):
             if math.isclose(result.resolution, resolution):
-                return result
+                return index
         raise InvalidInputError(f"no volumetric result at {resolution} m")
 
     def time_ratio(self, resolution: float, basis: str = "search") -> float:

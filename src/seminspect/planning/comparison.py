@@ -151,6 +151,10 @@ def fine_segment_validity(
     (A path from free space cannot reach the inside of a solid without crossing its surface.)
     """
     points = as_points(waypoints, "waypoints", allow_empty=True)
+    if not (math.isfinite(radius) and radius >= 0):
+        raise InvalidInputError(f"radius must be a finite number >= 0, got {radius!r}")
+    if not (math.isfinite(resolution) and resolution > 0):
+        raise InvalidInputError(f"resolution must be a positive number, got {resolution!r}")
     check = _FineCheck(world.triangles, radius, resolution)
     return np.array(
         [

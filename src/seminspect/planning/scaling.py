@@ -16,10 +16,11 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.rng import make_rng
+from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.model import FeatureNode
 from seminspect.graphs.lsg.synthetic import VEHICLE_SIZE, synthetic_graph, synthetic_layout
 from seminspect.mapping.voxel import VoxelMap
@@ -92,7 +93,7 @@ def scaling_point(
     volumetric = VolumetricPlanner(voxel_map, CostModel(robot_radius), band=band)
     search, plan_s, settled, vp, expansions, ratio_search, ratio_plan = ([] for _ in range(7))
     failures = 0
-    for start, goal in _random_queries(graph, queries, seed):
+    for start, goal in random_queries(graph, queries, seed):
         route, timing = time_hierarchical(lambda s=start, g=goal: hierarchical.plan(g, s), repeats)
         answer = time_volumetric(volumetric, start, route.waypoints[-1], repeats=1)
         search.append(timing.search_s)
@@ -152,8 +153,11 @@ def growth_exponent(sizes: ArrayLike, times: ArrayLike) -> float:
     return float(np.polyfit(x, y, 1)[0])
 
 
-def _random_queries(graph, count: int, seed: int) -> list[tuple[np.ndarray, str]]:
-    """Starts within about a metre of random view poses, goals at random features."""
+def random_queries(
+    graph: LayeredSemanticGraph, count: int, seed: int
+) -> list[tuple[NDArray[np.float64], str]]:
+    """``count`` (start, feature id) pairs: starts within about a metre of random view poses,
+    goals at random features."""
     rng = make_rng(seed, "scaling", f"queries-{len(graph.targets())}")
     features = [n.id for n in graph.nodes() if isinstance(n, FeatureNode)]
     poses = [p.position for t in graph.targets() for lv in t.levels for p in lv.poses]

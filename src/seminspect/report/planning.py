@@ -74,12 +74,7 @@ def run_summary(run: RunComparison) -> dict[str, Any]:
     for res in RESOLUTIONS:
         key = f"{res:g}"
         summary[f"vp_{key}_s"] = stats(q.volumetric(res).time_s for q in queries)
-        summary[f"vp_{key}_valid_segments"] = _share(
-            c
-            for q in queries
-            for r, c in zip(q.vp, q.vp_checks, strict=True)
-            if r.resolution == res
-        )
+        summary[f"vp_{key}_valid_segments"] = _share(q.vp_check(res) for q in queries)
         summary[f"vp_{key}_failures"] = sum(q.volumetric(res).error is not None for q in queries)
         for basis in ("search", "plan", "query", "refined"):
             summary[f"time_ratio_{key}_{basis}"] = stats(q.time_ratio(res, basis) for q in queries)
@@ -191,7 +186,7 @@ def query_table(run: RunComparison) -> list[str]:
     ]
     for q in run.queries:
         vp = " | ".join(f"{_ms(r.time_s)} / {_num(r.length, 1)}" for r in q.vp)
-        check05 = next(c for r, c in zip(q.vp, q.vp_checks, strict=True) if r.resolution == 0.5)
+        check05 = q.vp_check(0.5)
         lines.append(
             f"| {q.query} | {q.straight_m:.1f} | {_us(q.hp.target_layer_s)} / "
             f"{q.hp_target_layer_m:.1f} | {_us(q.hp.local_layers_s)} | {q.hp_length_m:.1f} "
