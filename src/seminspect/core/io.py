@@ -167,7 +167,8 @@ def read_versioned_json(
     if found_kind != kind:
         raise FileFormatError(f"{path}: expected a {kind!r} file, found format {found_kind!r}")
     found_version = document.get("version")
-    if found_version not in supported:
+    # exact integers only: ``True == 1`` and ``1.0 == 1`` in Python, and neither is a version
+    if type(found_version) is not int or found_version not in supported:
         raise FileFormatError(
             f"{path}: {kind} version {found_version!r} is not supported (supported: {supported})"
         )

@@ -55,6 +55,8 @@ def load_point_file(path: str | Path) -> PointData:
 
 
 def _read_bytes(source: Path) -> bytes:
+    if source.is_dir():
+        raise FileFormatError(f"{source}: is a directory, expected a point file")
     if not source.is_file():
         raise FileFormatError(f"{source}: no such file")
     size = source.stat().st_size

@@ -133,6 +133,8 @@ WORLD_DEFAULTS: dict[str, dict[str, Any]] = {
         "classes": ("building",), "features": BUILDING_FEATURES,
     },
 }  # fmt: skip
+#: A user world (``world`` is a path) takes the city's defaults; it has no scenarios.
+USER_WORLD_DEFAULTS = {k: v for k, v in WORLD_DEFAULTS["city"].items() if k != "scenario"}
 
 
 def make_config(values: dict[str, Any]) -> MissionConfig:
@@ -142,7 +144,7 @@ def make_config(values: dict[str, Any]) -> MissionConfig:
 
 def resolve(config: MissionConfig) -> MissionConfig:
     """Fill every ``None`` field with the world's default."""
-    defaults = WORLD_DEFAULTS.get(config.world, WORLD_DEFAULTS["city"])
+    defaults = WORLD_DEFAULTS.get(config.world, USER_WORLD_DEFAULTS)
     budget = defaults["budget"]
     inspection = config.inspection or InspectionConfig(d_view=defaults["d_view"])
     return config.model_copy(
