@@ -130,7 +130,7 @@ def plan_summary(plan: RoutePlan) -> dict[str, object]:
 
 def _print_plan(plan: RoutePlan) -> None:
     loc = plan.localisation
-    console.print(f"[bold]{plan.query}[/]")
+    console.print(plan.query, style="bold")
     console.print(
         f"robot localised at {loc.node_id} ({loc.distance:.2f} m away): "
         f"target {loc.target_id}, level {loc.level_id.rsplit('/', 1)[-1]}"

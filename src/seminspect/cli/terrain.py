@@ -7,7 +7,7 @@ from typing import Any
 
 import typer
 
-from seminspect.cli._common import console
+from seminspect.cli._common import console, labelled
 
 app = typer.Typer(no_args_is_help=True, help="Terrain-aware, task-driven outdoor scene graphs.")
 
@@ -230,7 +230,7 @@ def graph(
         "quality": quality,
     }
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2) + "\n")
-    console.print(f"[bold]terrain graph[/] written to {out}")
+    console.print(labelled("terrain graph", "bold", f"written to {out}"))
     console.print_json(json.dumps({k: v for k, v in summary.items() if k != "seconds"}))
 
 
@@ -292,11 +292,15 @@ def map_command(
     save_cloud(out, run.cloud)
     seconds = run.seconds
     console.print(
-        f"[bold]semantic cloud[/] written to {out}: {len(run.cloud):,} points from "
-        f"{run.frames} frames over {run.distance:.0f} m, {run.cloud.counts.mean():.1f} views "
-        f"per point; {seconds['total']:.1f} s ({1000 * seconds['total'] / run.frames:.0f} ms "
-        f"per frame: sensors {seconds['sensors']:.1f} s, segments {seconds['segments']:.1f} s, "
-        f"fusion {seconds['fusion']:.1f} s)",
+        labelled(
+            "semantic cloud",
+            "bold",
+            f"written to {out}: {len(run.cloud):,} points from "
+            f"{run.frames} frames over {run.distance:.0f} m, {run.cloud.counts.mean():.1f} views "
+            f"per point; {seconds['total']:.1f} s ({1000 * seconds['total'] / run.frames:.0f} ms "
+            f"per frame: sensors {seconds['sensors']:.1f} s, segments {seconds['segments']:.1f} s, "
+            f"fusion {seconds['fusion']:.1f} s)",
+        ),
         highlight=False,
         soft_wrap=True,
     )

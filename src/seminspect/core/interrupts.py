@@ -16,7 +16,10 @@ from collections.abc import Iterator
 from types import FrameType
 
 #: The signals that ask a run to stop, and how a person would name them.
-STOP_SIGNALS: dict[int, str] = {signal.SIGINT: "Ctrl-C", signal.SIGTERM: "SIGTERM"}
+STOP_SIGNALS: dict[int, str] = {
+    signal.SIGINT: "interrupted by the operator (Ctrl-C)",
+    signal.SIGTERM: "stopped by SIGTERM",
+}
 
 
 class Interrupted(KeyboardInterrupt):
@@ -32,7 +35,7 @@ class Interrupted(KeyboardInterrupt):
         return 128 + self.signum
 
     def describe(self) -> str:
-        return f"interrupted ({STOP_SIGNALS.get(self.signum, f'signal {self.signum}')})"
+        return STOP_SIGNALS.get(self.signum, f"stopped by signal {self.signum}")
 
 
 def as_interrupted(exc: KeyboardInterrupt) -> Interrupted:

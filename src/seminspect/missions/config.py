@@ -88,7 +88,9 @@ class MissionConfig(_Strict):
         description="the robot waits for every planner call's wall time, so slow planning costs "
         "mission time (000 Sec VII-D); off by default because wall time varies between runs",
     )
-    time_budget_s: float | None = Field(None, gt=0, description="simulated seconds")
+    time_budget_s: float | None = Field(
+        None, gt=0, allow_inf_nan=False, description="simulated seconds"
+    )
     map_resolution: float = Field(0.3, ge=0.1, le=1.0, description="robot's occupancy map [m]")
     target_classes: tuple[str, ...] | None = None
     feature_labels: tuple[str, ...] | None = None
