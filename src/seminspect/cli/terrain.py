@@ -7,7 +7,7 @@ from typing import Any
 
 import typer
 
-from seminspect.cli._common import console, labelled
+from seminspect.cli._common import console, labelled, writable_directory, writable_file
 
 app = typer.Typer(no_args_is_help=True, help="Terrain-aware, task-driven outdoor scene graphs.")
 
@@ -80,6 +80,15 @@ def _load_cloud(inputs: list[Path], labels: list[Path], options: dict[str, Any],
             return cloud, None
     names = label_names_from_text(options["label_names"]) if options["label_names"] else None
     return cloud_from_point_data(load_point_file(source), encoder, names), None
+
+
+def _positive_radius(radius: float) -> None:
+    import math
+
+    from seminspect.core.errors import InvalidInputError
+
+    if not (math.isfinite(radius) and radius > 0):
+        raise InvalidInputError(f"--radius must be a positive number of metres, got {radius}")
 
 
 def _encoder(name: str, noise: float, seed: int):
@@ -195,6 +204,8 @@ def graph(
     from seminspect.graphs.terrain.scene_graph import build_terrain_graph
     from seminspect.perception.encoders import calibration_for
 
+    writable_directory(out)
+    _positive_radius(radius)
     prompts = TaskPrompts.parse(terrain, objects)
     params = make_terrain_params(_param_overrides(param, cell_size))
     encoder = _encoder(encoder_name, noise, seed)
@@ -254,7 +265,9 @@ def route(
 @app.command("map")
 def map_command(
     out: Path = typer.Option(..., "--out", help="The semantic cloud to write (.npz)."),
-    world: str = typer.Option("outdoor", help="Built-in world with a drive path."),
+    world: str = typer.Option(
+        "outdoor", help="World with a drive path: a built-in name or a user world folder."
+    ),
     scenario: str | None = typer.Option(
         None, "--scenario", "-s", help="World scenario (the world's default when omitted)."
     ),
@@ -275,10 +288,11 @@ def map_command(
 
     from seminspect.mapping.semantic_cloud import save_cloud
     from seminspect.missions.terrain_mapping import make_mapping_params, map_world
-    from seminspect.worlds import generate_world
+    from seminspect.worlds import open_world
 
+    writable_file(out, (".npz",))
     params = make_mapping_params({"spacing": spacing, "radius": radius})
-    site = generate_world(world, scenario, seed)
+    site = open_world(world, scenario, seed)
     encoder = _encoder(encoder_name, noise, seed)
     columns = (*Progress.get_default_columns()[:2], MofNCompleteColumn(), TimeElapsedColumn())
     with Progress(*columns, console=console, transient=True) as progress:

@@ -45,6 +45,8 @@ class PointData:
 def load_point_file(path: str | Path) -> PointData:
     """Read a ``.ply``, ``.pcd`` or ``.npz`` point file (by extension)."""
     source = Path(path)
+    if source.is_dir():
+        raise FileFormatError(f"{source}: is a directory, expected a point file")
     readers = {".ply": read_ply, ".pcd": read_pcd, ".npz": read_point_npz}
     reader = readers.get(source.suffix.lower())
     if reader is None:
@@ -55,8 +57,6 @@ def load_point_file(path: str | Path) -> PointData:
 
 
 def _read_bytes(source: Path) -> bytes:
-    if source.is_dir():
-        raise FileFormatError(f"{source}: is a directory, expected a point file")
     if not source.is_file():
         raise FileFormatError(f"{source}: no such file")
     size = source.stat().st_size
