@@ -138,6 +138,7 @@ class RunDirectory:
         """
         lock = _RunLock.acquire(self.path(LOCK_FILE))
         heartbeat = threading.Event()
+        self.finished = False
         try:
             clear_previous_run(self.root)
             self.write_config(config)
