@@ -177,7 +177,10 @@ def graph(
         None, help="Names of a cloud's integer labels, e.g. '0=grass,1=car'."
     ),
     encoder_name: str = typer.Option(
-        "minilm", "--encoder", help="Registered encoder name or package.module:factory."
+        "minilm",
+        "--encoder",
+        help="Registered encoder name, or package.module:factory, which imports that module "
+        "and runs the factory (only name code you trust).",
     ),
     noise: float = typer.Option(0.0, help="Caption noise per view (labelled input)."),
     seed: int = typer.Option(0, help="Seed of the caption noise."),
@@ -273,7 +276,10 @@ def map_command(
     ),
     seed: int = typer.Option(0, help="Seed of the world and of the caption noise."),
     encoder_name: str = typer.Option(
-        "minilm", "--encoder", help="Registered encoder name or package.module:factory."
+        "minilm",
+        "--encoder",
+        help="Registered encoder name, or package.module:factory, which imports that module "
+        "and runs the factory (only name code you trust).",
     ),
     noise: float = typer.Option(0.3, help="Caption noise per view (caption encoders)."),
     spacing: float = typer.Option(1.0, help="Metres driven between frames."),

@@ -156,11 +156,14 @@ def read_json(path: str | os.PathLike[str], max_bytes: int = MAX_JSON_BYTES) -> 
 
 
 def read_versioned_json(
-    path: str | os.PathLike[str], kind: str, versions: Iterable[int]
+    path: str | os.PathLike[str],
+    kind: str,
+    versions: Iterable[int],
+    max_bytes: int = MAX_JSON_BYTES,
 ) -> dict[str, Any]:
     """Read a document written by :func:`write_versioned_json`, checking its kind and version."""
     supported = sorted(set(versions))
-    document = read_json(path)
+    document = read_json(path, max_bytes)
     if not isinstance(document, dict):
         raise FileFormatError(f"{path}: expected a JSON object, found {type(document).__name__}")
     found_kind = document.get("format")
