@@ -166,19 +166,19 @@ def test_nan_coordinates_are_named_in_the_error(capsys) -> None:
 
 
 def test_a_user_world_folder_works_where_a_name_does(capsys, tmp_path) -> None:
-    code, _, _ = run(capsys, "world", "export", "subterranean", "--out", str(tmp_path / "site"))
+    code, _, _ = run(capsys, "world", "export", "subterranean", "--out", str(tmp_path / "[/b]site"))
     assert code == 0
     code, text, err = run(
-        capsys, "world", "show", str(tmp_path / "site"), "--out", str(tmp_path / "site.png")
+        capsys, "world", "show", str(tmp_path / "[/b]site"), "--out", str(tmp_path / "site.png")
     )
     assert code == 0, err
     assert (tmp_path / "site.png").read_bytes()[:4] == b"\x89PNG" and "car-1" in text
-    code, _, err = run(capsys, "world", "show", str(tmp_path / "site"), "--scenario", "small")
+    code, _, err = run(capsys, "world", "show", str(tmp_path / "[/b]site"), "--scenario", "small")
     assert code == 1 and "has no scenarios" in err
     code, text, err = run(
-        capsys, "mission", "--world", str(tmp_path / "site"), "--budget", "5", "--no-pictures",
+        capsys, "mission", "--world", str(tmp_path / "[/b]site"), "--budget", "5", "--no-pictures",
         "--out", str(tmp_path / "run"),
     )  # fmt: skip
     assert code == 0, err
     config = json.loads((tmp_path / "run" / "config.json").read_text())["config"]
-    assert config["world"] == str((tmp_path / "site").resolve()) and config["scenario"] is None
+    assert config["world"] == str((tmp_path / "[/b]site").resolve()) and config["scenario"] is None

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 import typer
 from rich.table import Table
+from rich.text import Text
 
 from seminspect.cli._common import console, writable_directory, writable_file
 
@@ -61,7 +62,7 @@ def show(
 
     target = writable_file(out or Path(f"{Path(name).stem}.png"), (".png",))
     world = _generate(name, scenario, seed)
-    with console.status(f"drawing {name}"):
+    with console.status(Text(f"drawing {name}")):  # a spinner reads markup from plain str
         save_world_picture(world, target, view.value)
     kind = world.metadata.get("scenario", "user world")
     table = Table(title=f"{name} ({kind}), seed {seed}", title_justify="left")
