@@ -20,12 +20,7 @@ from typing import Any
 import numpy as np
 
 from seminspect.core.errors import SeminspectError
-from seminspect.core.interrupts import (
-    Interrupted,
-    as_interrupted,
-    deferred_signals,
-    stop_on_signals,
-)
+from seminspect.core.interrupts import as_interrupted, deferred_signals, stop_on_signals
 from seminspect.mapping.voxel import VoxelMap
 from seminspect.missions.config import MissionConfig, inspection_params, resolve
 from seminspect.missions.evaluation import (
@@ -177,7 +172,7 @@ def _run(
         raise SeminspectError(
             f"mission failed ({reason}); partial results in {run.root}"
         ) from error
-    signum = stop.signum if isinstance(stop, Interrupted) else None
+    signum = stop.signum if stop else None
     return MissionResult(run.root, state, reason, metrics, mission, world, answers, signum)
 
 
