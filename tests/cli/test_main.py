@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from cli_runner import run
+from seminspect.cli import _common as cli_common
 from seminspect.cli.graph import example_graph_path
 from seminspect.mapping.semantic_cloud import CLOUD_FORMAT
 
@@ -144,6 +145,19 @@ def test_an_out_in_a_read_only_directory_is_refused_before_work(capsys, tmp_path
     locked.mkdir(mode=0o500)
     code, _, err = run(capsys, *args, "--out", str(locked / "run"))
     assert code == 1 and "not writable" in err and str(locked) in err
+
+
+def test_an_unwritable_folder_is_named_before_work(capsys, tmp_path, monkeypatch) -> None:
+    monkeypatch.setattr(cli_common.os, "access", lambda path, mode: False)  # as for non-root
+    for args in (["world", "export", "campus"], ["graph", "show", "example"]):
+        code, _, err = run(capsys, *args, "--out", str(tmp_path / "new" / "out.png"))
+        assert code == 1 and f"{tmp_path} is not writable" in err, err
+
+
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux /proc")
+def test_a_file_the_system_will_not_write_is_one_line_naming_it(capsys) -> None:
+    code, _, err = run(capsys, "graph", "export", "example", "--out", "/proc/seminspect.json")
+    assert code == 1 and err.startswith("error: /proc/seminspect.json: ") and err.count("\n") == 1
 
 
 @pytest.mark.parametrize("text", ["Visit [/b]car-1", "Visit [blink]car-1[/blink]"])

@@ -38,11 +38,19 @@ def _file_mode() -> int:
 _FILE_MODE = _file_mode()
 
 
+def _temporary_beside(target: Path, suffix: str) -> tuple[int, str]:
+    """A new temporary file in ``target``'s folder; an error names ``target``, not the temporary."""
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        return tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix, dir=target.parent)
+    except OSError as exc:
+        raise OSError(exc.errno, exc.strerror, str(target)) from None
+
+
 def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> Path:
     """Write ``data`` to ``path`` atomically (temporary file + fsync + rename)."""
     target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    fd, tmp_name = _temporary_beside(target, ".tmp")
     try:
         os.fchmod(fd, _FILE_MODE)
         with os.fdopen(fd, "wb") as handle:
@@ -61,10 +69,7 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[Path]:
     """Yield a temporary path beside ``path`` for a third-party writer; rename it over ``path``
     only when the block succeeds (the temporary file is removed otherwise)."""
     target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(
-        prefix=f".{target.name}.", suffix=target.suffix, dir=target.parent
-    )
+    fd, tmp_name = _temporary_beside(target, target.suffix)
     os.fchmod(fd, _FILE_MODE)
     os.close(fd)
     tmp = Path(tmp_name)
