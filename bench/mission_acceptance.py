@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 from seminspect.missions.config import make_config, resolve
@@ -82,9 +83,12 @@ def main() -> None:
         name = f"{world}-{scenario or 'default'}-seed{seed}"
         config = resolve(make_config({"world": world, "scenario": scenario, "seed": seed}))
         out = Path(args.out) / name
-        if args.reuse and reusable_run(out, config):
+        reuse = reusable_run(out, config) if args.reuse else None
+        if reuse:
             metrics = read_run_metrics(out)
         else:
+            if reuse is not None:
+                print(f"running {name} again: {reuse.reason}", file=sys.stderr, flush=True)
             metrics = run_mission(config, out).metrics
         results.append({**metrics, "run": {"world": world, "scenario": scenario, "seed": seed}})
         print(row(world, scenario, seed, metrics), flush=True)

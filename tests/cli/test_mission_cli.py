@@ -28,3 +28,18 @@ def test_bad_mission_settings_exit_non_zero_with_one_line(capsys, tmp_path, args
     code, _, err = run(capsys, *args, "--out", str(tmp_path / "run"))
     assert code != 0 and message in err and "Traceback" not in err
     assert err.strip().count("\n") == 0  # one line
+
+
+def test_resume_refuses_mixed_settings_and_finished_runs(capsys, tmp_path: Path) -> None:
+    from seminspect.missions.config import make_config, resolve
+    from seminspect.missions.rundir import RunDirectory
+
+    config = resolve(make_config({"world": "subterranean"})).model_dump(mode="json")
+    with RunDirectory(tmp_path / "run").claimed(config) as stored:
+        stored.finish("completed")
+    code, _, err = run(capsys, "mission", "--resume", str(tmp_path / "run"), "--seed", "2")
+    assert code == 1 and "drop --seed" in err
+    code, _, err = run(capsys, "mission", "--resume", str(tmp_path / "run"))
+    assert code == 1 and "completed run; nothing to resume" in err
+    code, _, err = run(capsys, "mission", "--resume", str(tmp_path))
+    assert code == 1 and "not a run directory" in err

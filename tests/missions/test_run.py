@@ -14,7 +14,7 @@ from seminspect.graphs.lsg.model import EdgeKind
 from seminspect.mapping.voxel import load_map
 from seminspect.missions.config import make_config
 from seminspect.missions.run import run_mission
-from seminspect.missions.rundir import load_trajectory
+from seminspect.missions.rundir import RunDirectory, load_trajectory
 from seminspect.missions.xflie import XFlie
 from seminspect.planning.hierarchical import HierarchicalPlanner
 
@@ -154,3 +154,25 @@ def test_the_volumetric_baseline_mission_plans_with_charged_time(tmp_path: Path)
     assert metrics["table6"]["planning_load_pct"] == pytest.approx(
         100 * planning / metrics["mission"]["sim_time_s"]
     )
+
+
+def test_a_ctrl_c_while_writing_outputs_is_not_reported_as_completed(tmp_path, monkeypatch) -> None:
+    def interrupted_write(self, occupancy) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(RunDirectory, "write_map", interrupted_write)
+    config = make_config({"world": "subterranean", "time_budget_s": 10})
+    result = run_mission(config, tmp_path / "run")
+    status = read_versioned_json(tmp_path / "run" / "status.json", "seminspect.run-status", [1])
+    assert result.state == status["state"] == "interrupted"
+    assert "while writing the outputs" in status["reason"]
+    for missing in ("map.npz", "metrics.json"):
+        assert missing in status["reason"] and not (tmp_path / "run" / missing).exists()
+    assert load_graph(tmp_path / "run" / "graph.json") is not None  # written before the maps
+
+
+def test_a_bad_world_creates_no_run_directory(tmp_path) -> None:
+    config = make_config({"world": "campus", "scenario": "huge"})
+    with pytest.raises(SeminspectError, match="unknown campus scenario"):
+        run_mission(config, base=tmp_path)
+    assert not list(tmp_path.iterdir())

@@ -269,3 +269,18 @@ def test_gazebo_prius_wheels_keep_their_labels(shared_data: Path, tmp_path: Path
             _, face = world.raycaster.cast((x, y0, 0.3), np.array([[0, dy, 0]], np.float32))
             assert world.instances[world.face_instance[face[0]]].name == "prius-1"
             assert world.part_names[world.face_part[face[0]]] == f"{end}-{side}-wheel"
+
+
+def test_a_world_path_names_a_folder_a_labels_file_or_a_mesh(tmp_path) -> None:
+    from seminspect.core.errors import FileFormatError
+    from seminspect.worlds import generate_world, open_world, save_world
+
+    folder = save_world(generate_world("subterranean"), tmp_path / "tunnel")
+    names = {w.name for w in (open_world(str(folder)), open_world(str(folder / "labels.json")))}
+    names.add(open_world(str(folder / "world.ply")).name)
+    assert names == {generate_world("subterranean").name}
+    (folder / "copy.obj").write_text("v 0 0 0\n")
+    with pytest.raises(FileFormatError, match=r"exactly one mesh .*copy\.obj, world\.ply"):
+        open_world(str(folder))
+    with pytest.raises(FileFormatError, match="no such world file"):
+        open_world(str(tmp_path / "gone"))

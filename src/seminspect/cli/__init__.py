@@ -3,22 +3,26 @@
 Each command group lives in its own module and is registered in :data:`GROUPS`. Errors a user
 can cause (:class:`~seminspect.core.errors.SeminspectError`) become one line on stderr and exit
 code 1; an unexpected exception becomes one line too, with the traceback behind ``--debug``.
+Ctrl-C and SIGTERM stop any command with exit code 130 and 143. User text is printed as typed.
 """
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import os
 import sys
-from collections.abc import Sequence
+import warnings
+from collections.abc import Iterator, Sequence
 
 import typer
 from pydantic import ValidationError
 
 from seminspect import __version__
-from seminspect.cli._common import err_console
+from seminspect.cli._common import err_console, labelled
 from seminspect.core.config import describe_validation_error
 from seminspect.core.errors import SeminspectError
+from seminspect.core.interrupts import Interrupted, as_interrupted, stop_on_signals
 
 #: Typer ships its own click; take its usage-error class from a public exception's ancestry.
 _USAGE_ERROR = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "UsageError")
@@ -77,44 +81,75 @@ _register_groups()
 
 
 def main(argv: Sequence[str] | None = None) -> None:
-    """Console entry point: run the app and turn errors into one readable line."""
+    """Console entry point: run the app and turn errors into one readable line.
+
+    Exit codes: 0 done, 1 a user error, 2 a usage error, 3 a bug, and for a stop signal 128 plus
+    its number (130 for Ctrl-C, 143 for SIGTERM, which is handled the same way).
+    """
     args = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in args or os.environ.get("SEMINSPECT_DEBUG") == "1"
+    with stop_on_signals(), _warnings_as_lines():
+        code = _run_app(args, debug)
+    raise SystemExit(code)
+
+
+def _run_app(args: list[str], debug: bool) -> int:
+    """The exit code of the app on ``args``, every error reported in one line."""
     try:
-        app(args=args, prog_name="seminspect", standalone_mode=False)
-    except typer.Exit as done:
-        raise SystemExit(done.exit_code) from None
-    except _USAGE_ERROR as exc:
-        if type(exc).__name__ == "NoArgsIsHelpError":  # the help was printed
-            raise SystemExit(0) from None
-        command = exc.ctx.command_path if exc.ctx else "seminspect"
-        err_console.print(
-            f"[bold red]error:[/] {exc.format_message()} (see '{command} --help')",
-            highlight=False,
-            soft_wrap=True,
-        )
-        raise SystemExit(2) from None
-    except typer.Abort:
-        err_console.print("interrupted", highlight=False)
-        raise SystemExit(130) from None
-    except (SeminspectError, ValidationError) as exc:
-        if debug:
+        result = app(args=args, prog_name="seminspect", standalone_mode=False)
+    except (Exception, KeyboardInterrupt) as exc:
+        if debug and not isinstance(
+            exc, typer.Exit | typer.Abort | _USAGE_ERROR | KeyboardInterrupt
+        ):
             raise
-        message = (
-            describe_validation_error(exc, "value") if isinstance(exc, ValidationError) else exc
+        return _report(exc)
+    # typer returns a command's exit code in non-standalone mode instead of exiting
+    return result if isinstance(result, int) else 0
+
+
+def _report(exc: BaseException) -> int:
+    """Print what stopped the command in one line; its exit code."""
+    if isinstance(exc, typer.Exit):
+        code = exc.exit_code
+    elif isinstance(exc, _USAGE_ERROR):
+        code = 0 if type(exc).__name__ == "NoArgsIsHelpError" else 2  # 0: the help was printed
+        if code:
+            command = exc.ctx.command_path if exc.ctx else "seminspect"
+            _error("error:", f"{exc.format_message()} (see '{command} --help')")
+    elif isinstance(exc, KeyboardInterrupt | typer.Abort):
+        stop = as_interrupted(exc) if isinstance(exc, KeyboardInterrupt) else Interrupted()
+        err_console.print(stop.describe(), highlight=False)
+        code = stop.exit_code
+    elif isinstance(exc, SeminspectError | ValidationError):
+        is_validation = isinstance(exc, ValidationError)
+        _error("error:", describe_validation_error(exc, "value") if is_validation else exc)
+        code = 1
+    elif isinstance(exc, OSError) and exc.filename is not None:
+        # a file the user named could not be read or written: their fix, not a bug
+        _error("error:", f"{exc.filename}: {exc.strerror}")
+        code = 1
+    else:
+        _error(
+            "internal error:", f"{type(exc).__name__}: {exc} (rerun with --debug for the traceback)"
         )
-        err_console.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
-        raise SystemExit(1) from None
-    except KeyboardInterrupt:
-        err_console.print("interrupted", highlight=False)
-        raise SystemExit(130) from None
-    except Exception as exc:
-        if debug:
-            raise
-        err_console.print(
-            f"[bold red]internal error:[/] {type(exc).__name__}: {exc} "
-            "(rerun with --debug for the traceback)",
-            highlight=False,
-            soft_wrap=True,
-        )
-        raise SystemExit(3) from None
+        code = 3
+    return code
+
+
+def _error(label: str, message: object) -> None:
+    err_console.print(labelled(label, "bold red", message), highlight=False, soft_wrap=True)
+
+
+@contextlib.contextmanager
+def _warnings_as_lines() -> Iterator[None]:
+    """Show warnings (a stale lock taken over, ...) as one ``warning:`` line each."""
+
+    def show(message, category, filename, lineno, file=None, line=None) -> None:
+        err_console.print(labelled("warning:", "yellow", message), highlight=False, soft_wrap=True)
+
+    previous = warnings.showwarning
+    warnings.showwarning = show
+    try:
+        yield
+    finally:
+        warnings.showwarning = previous

@@ -1,8 +1,59 @@
-"""Consoles shared by the command groups."""
+"""Consoles shared by the command groups, and the checks every command makes of its outputs.
+
+The consoles do not interpret rich markup: what a user typed (a query, a path, a node name)
+is printed as typed, ``[/b]`` included. Styled words are built with :class:`rich.text.Text`.
+"""
 
 from __future__ import annotations
 
-from rich.console import Console
+import os
+from pathlib import Path
 
-console = Console()
-err_console = Console(stderr=True)
+from rich.console import Console
+from rich.text import Text
+
+from seminspect.core.errors import InvalidInputError
+
+console = Console(markup=False)
+err_console = Console(stderr=True, markup=False)
+
+
+def labelled(label: str, style: str, message: object) -> Text:
+    """``label`` in ``style`` followed by ``message`` printed literally."""
+    return Text.assemble((label, style), " ", str(message))
+
+
+def writable_file(path: Path, suffixes: tuple[str, ...] = ()) -> Path:
+    """Check, before any work, that ``path`` can be written as a file (of one of ``suffixes``)."""
+    if path.is_dir():
+        raise InvalidInputError(f"{path} is a directory; give a file name to write")
+    if suffixes and path.suffix.lower() not in suffixes:
+        raise InvalidInputError(
+            f"{path}: cannot write {path.suffix or 'a file without suffix'}; "
+            f"use one of {', '.join(suffixes)}"
+        )
+    _check_parent(path)
+    return path
+
+
+def writable_directory(path: Path) -> Path:
+    """Check, before any work, that ``path`` is or can become a writable directory."""
+    if path.exists() and not path.is_dir():
+        raise InvalidInputError(f"{path} exists and is not a directory; choose another --out")
+    if path.is_dir():
+        if not os.access(path, os.W_OK | os.X_OK):
+            raise InvalidInputError(f"{path} is not writable; choose another --out")
+        return path
+    _check_parent(path)
+    return path
+
+
+def _check_parent(path: Path) -> None:
+    """The nearest existing folder above ``path`` must be a writable directory."""
+    parent = path.absolute().parent
+    while not parent.exists():
+        parent = parent.parent
+    if not parent.is_dir():
+        raise InvalidInputError(f"{path}: {parent} is not a directory")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise InvalidInputError(f"{path}: {parent} is not writable; choose another location")

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 import typer
 from rich.table import Table
 
-from seminspect.cli._common import console
+from seminspect.cli._common import console, writable_file
 
 if TYPE_CHECKING:
     from seminspect.graphs.lsg.graph import LayeredSemanticGraph
@@ -23,6 +23,7 @@ if TYPE_CHECKING:
 
 app = typer.Typer(no_args_is_help=True, add_completion=False)
 
+PICTURE_SUFFIXES = (".png", ".svg", ".pdf")
 GRAPH_HELP = "Graph JSON file, or 'example' for the graph shipped with seminspect."
 EXAMPLE = "example"
 
@@ -130,7 +131,7 @@ def plan_summary(plan: RoutePlan) -> dict[str, object]:
 
 def _print_plan(plan: RoutePlan) -> None:
     loc = plan.localisation
-    console.print(f"[bold]{plan.query}[/]")
+    console.print(plan.query, style="bold")
     console.print(
         f"robot localised at {loc.node_id} ({loc.distance:.2f} m away): "
         f"target {loc.target_id}, level {loc.level_id.rsplit('/', 1)[-1]}"
@@ -183,11 +184,11 @@ def export(
     """Write the graph as GraphML, seminspect JSON or a spark-dsg scene graph."""
     from seminspect.graphs.lsg.io import export_graphml, export_spark_dsg, save_graph
 
-    graph = _load(graph_file)
     source = Path("example_graph.json") if graph_file == EXAMPLE else Path(graph_file)
-    target = out or source.with_name(source.stem + _SUFFIX[fmt])
+    target = writable_file(out or source.with_name(source.stem + _SUFFIX[fmt]))
     if target.resolve() == source.resolve():
         raise typer.BadParameter("the output would overwrite the input; pass --out")
+    graph = _load(graph_file)
     writer = {
         ExportFormat.graphml: export_graphml,
         ExportFormat.json: save_graph,
@@ -212,6 +213,7 @@ def show(
     from seminspect.report.figures import save_figure
     from seminspect.report.lsg import draw_layers
 
+    writable_file(out, PICTURE_SUFFIXES)
     graph = _load(graph_file)
     plan = HierarchicalPlanner(graph).query(query_text) if query_text else None
     save_figure(draw_layers(graph, plan=plan, title=query_text), out)

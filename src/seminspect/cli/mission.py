@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import signal
 from enum import Enum
 from pathlib import Path
 
 import typer
 
-from seminspect.cli._common import console, err_console
+from seminspect.cli._common import console, err_console, labelled, writable_directory
 
 
 class ModeChoice(str, Enum):
@@ -26,8 +27,13 @@ class PlannerChoice(str, Enum):
 
 
 def app(
+    ctx: typer.Context,
     world: str = typer.Option(
-        "city", "--world", "-w", help="Built-in world (seminspect world list)."
+        "city",
+        "--world",
+        "-w",
+        help="Built-in world (seminspect world list), or a user world: a folder with a mesh and "
+        "its labels file, as 'seminspect world export' writes.",
     ),
     scenario: str | None = typer.Option(
         None, "--scenario", "-s", help="Scenario of the world (default: the world's; city: medium)."
@@ -62,24 +68,87 @@ def app(
     pictures: bool = typer.Option(
         True, "--pictures/--no-pictures", help="Draw the run's pictures."
     ),
+    resume: Path | None = typer.Option(
+        None,
+        "--resume",
+        help="Finish a run that was interrupted, failed or killed: run its configuration again "
+        "from the start into its directory (missions are deterministic).",
+    ),
 ) -> None:
     """Explore a site, inspect every target level by level and build its 3DLSG (paper 000).
 
     Writes a run directory with the graph, metrics, a summary, the trajectory and pictures.
+    Ctrl-C and SIGTERM stop the mission and leave a valid run directory (exit codes 130, 143).
     """
+    from seminspect.missions.config import make_config
+
+    if resume is not None:
+        config, out = _resumed(ctx, resume)
+    else:
+        config = make_config(
+            {
+                "world": _world_argument(world), "scenario": scenario, "seed": seed,
+                "preset": preset, "mode": None if mode is None else mode.value,
+                "noise": noise.value, "planner": planner.value, "time_budget_s": budget,
+            }
+        )  # fmt: skip
+        if out is not None:
+            writable_directory(out)
+    result = _run_with_progress(config, out, query)
+    if pictures and result.stop_signal != signal.SIGTERM:  # SIGTERM asks to stop now
+        from seminspect.report.mission import render_run
+
+        render_run(result.run_dir)
+    _print_result(result)
+    if result.state == "interrupted":
+        err_console.print(f"interrupted; partial results in {result.run_dir}", highlight=False)
+        raise typer.Exit(128 + (result.stop_signal or signal.SIGINT))
+
+
+def _world_argument(world: str) -> str:
+    """A world path is kept absolute, so the run's config finds it from anywhere."""
+    from seminspect.worlds.catalog import is_world_path
+
+    return str(Path(world).resolve()) if is_world_path(world) else world
+
+
+def _resumed(ctx: typer.Context, run_dir: Path):
+    """The configuration and directory of a run to finish; mission settings may not be mixed in."""
+    from seminspect.core.errors import InvalidInputError
+    from seminspect.missions.config import make_config
+    from seminspect.missions.rundir import resumable_config
+
+    given = [
+        f"--{name}"
+        for name in (
+            "world",
+            "scenario",
+            "seed",
+            "preset",
+            "mode",
+            "noise",
+            "planner",
+            "budget",
+            "out",
+        )
+        if ctx.get_parameter_source(name).name != "DEFAULT"
+    ]
+    if given:
+        raise InvalidInputError(
+            f"--resume runs the stored configuration of {run_dir}; drop {', '.join(given)}"
+        )
+    config = make_config(resumable_config(run_dir))
+    err_console.print(
+        f"resuming {run_dir}: running its configuration again from the start", highlight=False
+    )
+    return config, run_dir
+
+
+def _run_with_progress(config, out: Path | None, queries: list[str]):
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from seminspect.missions.config import make_config
     from seminspect.missions.run import run_mission
-    from seminspect.report.mission import render_run
 
-    config = make_config(
-        {
-            "world": world, "scenario": scenario, "seed": seed, "preset": preset,
-            "mode": None if mode is None else mode.value, "noise": noise.value,
-            "planner": planner.value, "time_budget_s": budget,
-        }
-    )  # fmt: skip
     columns = (
         TextColumn("[bold]{task.description}"),
         BarColumn(),
@@ -102,19 +171,13 @@ def app(
                 inspected=progress.inspected,
             )
 
-        result = run_mission(config, out, queries=query, progress=show)
-    if pictures:
-        render_run(result.run_dir)
-    _print_result(result)
-    if result.state == "interrupted":
-        err_console.print(f"interrupted; partial results in {result.run_dir}", highlight=False)
-        raise typer.Exit(130)
+        return run_mission(config, out, queries=queries, progress=show)
 
 
 def _print_result(result) -> None:
     metrics = result.metrics
     t3, t6, mission = metrics["table3"], metrics["table6"], metrics["mission"]
-    console.print(f"[bold]{result.state}[/]: {result.reason}")
+    console.print(labelled(f"{result.state}:", "bold", result.reason))
     console.print(
         f"targets detected {t3['detected_pct']:.0f}%, inspected {t3['inspected_pct']:.0f}% of "
         f"detected; localisation RMSE {_m(t6['localisation_rmse_m'])}; "

@@ -7,7 +7,7 @@ from typing import Any
 
 import typer
 
-from seminspect.cli._common import console
+from seminspect.cli._common import console, labelled, writable_directory, writable_file
 
 app = typer.Typer(no_args_is_help=True, help="Terrain-aware, task-driven outdoor scene graphs.")
 
@@ -80,6 +80,15 @@ def _load_cloud(inputs: list[Path], labels: list[Path], options: dict[str, Any],
             return cloud, None
     names = label_names_from_text(options["label_names"]) if options["label_names"] else None
     return cloud_from_point_data(load_point_file(source), encoder, names), None
+
+
+def _positive_radius(radius: float) -> None:
+    import math
+
+    from seminspect.core.errors import InvalidInputError
+
+    if not (math.isfinite(radius) and radius > 0):
+        raise InvalidInputError(f"--radius must be a positive number of metres, got {radius}")
 
 
 def _encoder(name: str, noise: float, seed: int):
@@ -168,7 +177,10 @@ def graph(
         None, help="Names of a cloud's integer labels, e.g. '0=grass,1=car'."
     ),
     encoder_name: str = typer.Option(
-        "minilm", "--encoder", help="Registered encoder name or package.module:factory."
+        "minilm",
+        "--encoder",
+        help="Registered encoder name, or package.module:factory, which imports that module "
+        "and runs the factory (only name code you trust).",
     ),
     noise: float = typer.Option(0.0, help="Caption noise per view (labelled input)."),
     seed: int = typer.Option(0, help="Seed of the caption noise."),
@@ -195,6 +207,8 @@ def graph(
     from seminspect.graphs.terrain.scene_graph import build_terrain_graph
     from seminspect.perception.encoders import calibration_for
 
+    writable_directory(out)
+    _positive_radius(radius)
     prompts = TaskPrompts.parse(terrain, objects)
     params = make_terrain_params(_param_overrides(param, cell_size))
     encoder = _encoder(encoder_name, noise, seed)
@@ -230,7 +244,7 @@ def graph(
         "quality": quality,
     }
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2) + "\n")
-    console.print(f"[bold]terrain graph[/] written to {out}")
+    console.print(labelled("terrain graph", "bold", f"written to {out}"))
     console.print_json(json.dumps({k: v for k, v in summary.items() if k != "seconds"}))
 
 
@@ -254,13 +268,18 @@ def route(
 @app.command("map")
 def map_command(
     out: Path = typer.Option(..., "--out", help="The semantic cloud to write (.npz)."),
-    world: str = typer.Option("outdoor", help="Built-in world with a drive path."),
+    world: str = typer.Option(
+        "outdoor", help="World with a drive path: a built-in name or a user world folder."
+    ),
     scenario: str | None = typer.Option(
         None, "--scenario", "-s", help="World scenario (the world's default when omitted)."
     ),
     seed: int = typer.Option(0, help="Seed of the world and of the caption noise."),
     encoder_name: str = typer.Option(
-        "minilm", "--encoder", help="Registered encoder name or package.module:factory."
+        "minilm",
+        "--encoder",
+        help="Registered encoder name, or package.module:factory, which imports that module "
+        "and runs the factory (only name code you trust).",
     ),
     noise: float = typer.Option(0.3, help="Caption noise per view (caption encoders)."),
     spacing: float = typer.Option(1.0, help="Metres driven between frames."),
@@ -275,10 +294,11 @@ def map_command(
 
     from seminspect.mapping.semantic_cloud import save_cloud
     from seminspect.missions.terrain_mapping import make_mapping_params, map_world
-    from seminspect.worlds import generate_world
+    from seminspect.worlds import open_world
 
+    writable_file(out, (".npz",))
     params = make_mapping_params({"spacing": spacing, "radius": radius})
-    site = generate_world(world, scenario, seed)
+    site = open_world(world, scenario, seed)
     encoder = _encoder(encoder_name, noise, seed)
     columns = (*Progress.get_default_columns()[:2], MofNCompleteColumn(), TimeElapsedColumn())
     with Progress(*columns, console=console, transient=True) as progress:
@@ -292,11 +312,15 @@ def map_command(
     save_cloud(out, run.cloud)
     seconds = run.seconds
     console.print(
-        f"[bold]semantic cloud[/] written to {out}: {len(run.cloud):,} points from "
-        f"{run.frames} frames over {run.distance:.0f} m, {run.cloud.counts.mean():.1f} views "
-        f"per point; {seconds['total']:.1f} s ({1000 * seconds['total'] / run.frames:.0f} ms "
-        f"per frame: sensors {seconds['sensors']:.1f} s, segments {seconds['segments']:.1f} s, "
-        f"fusion {seconds['fusion']:.1f} s)",
+        labelled(
+            "semantic cloud",
+            "bold",
+            f"written to {out}: {len(run.cloud):,} points from "
+            f"{run.frames} frames over {run.distance:.0f} m, {run.cloud.counts.mean():.1f} views "
+            f"per point; {seconds['total']:.1f} s ({1000 * seconds['total'] / run.frames:.0f} ms "
+            f"per frame: sensors {seconds['sensors']:.1f} s, segments {seconds['segments']:.1f} s, "
+            f"fusion {seconds['fusion']:.1f} s)",
+        ),
         highlight=False,
         soft_wrap=True,
     )

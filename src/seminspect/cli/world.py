@@ -1,4 +1,4 @@
-"""``seminspect world``: list, draw and export the built-in simulated worlds."""
+"""``seminspect world``: list, draw and export the built-in simulated worlds and user worlds."""
 
 from __future__ import annotations
 
@@ -8,8 +8,9 @@ from typing import TYPE_CHECKING
 
 import typer
 from rich.table import Table
+from rich.text import Text
 
-from seminspect.cli._common import console
+from seminspect.cli._common import console, writable_directory, writable_file
 
 if TYPE_CHECKING:
     from seminspect.worlds import World
@@ -23,14 +24,15 @@ class View(str, Enum):
     both = "both"
 
 
+NAME_HELP = "World name, e.g. city, or a user world folder (mesh + labels file)."
 SCENARIO_HELP = "Scenario of the world (its default when omitted; see 'seminspect world list')."
 SEED_HELP = "Seed of every random choice; the same seed gives the same world."
 
 
 def _generate(name: str, scenario: str | None, seed: int) -> World:
-    from seminspect.worlds import generate_world
+    from seminspect.worlds import open_world
 
-    return generate_world(name, scenario, seed)
+    return open_world(name, scenario, seed)
 
 
 @app.command("list")
@@ -49,7 +51,7 @@ def list_worlds() -> None:
 
 @app.command()
 def show(
-    name: str = typer.Argument(..., help="World name, e.g. city."),
+    name: str = typer.Argument(..., help=NAME_HELP),
     scenario: str = typer.Option(None, "--scenario", "-s", help=SCENARIO_HELP),
     seed: int = typer.Option(0, "--seed", min=0, help=SEED_HELP),
     out: Path = typer.Option(None, "--out", "-o", help="PNG to write (default: NAME.png)."),
@@ -58,11 +60,12 @@ def show(
     """Draw a world: a labelled top-down map and a 3D view, and list its objects."""
     from seminspect.report.worlds import save_world_picture
 
+    target = writable_file(out or Path(f"{Path(name).stem}.png"), (".png",))
     world = _generate(name, scenario, seed)
-    target = out or Path(f"{name}.png")
-    with console.status(f"drawing {name}"):
+    with console.status(Text(f"drawing {name}")):  # a spinner reads markup from plain str
         save_world_picture(world, target, view.value)
-    table = Table(title=f"{name} ({world.metadata['scenario']}), seed {seed}", title_justify="left")
+    kind = world.metadata.get("scenario", "user world")
+    table = Table(title=f"{name} ({kind}), seed {seed}", title_justify="left")
     for column in ("object", "class", "x", "y", "length", "width", "height", "parts"):
         table.add_column(column, justify="left" if column in {"object", "class"} else "right")
     for info in world.instances.values():
@@ -83,7 +86,7 @@ def show(
 
 @app.command()
 def export(
-    name: str = typer.Argument(..., help="World name, e.g. city."),
+    name: str = typer.Argument(..., help=NAME_HELP),
     out: Path = typer.Option(..., "--out", "-o", help="Directory for world.ply and labels.json."),
     scenario: str = typer.Option(None, "--scenario", "-s", help=SCENARIO_HELP),
     seed: int = typer.Option(0, "--seed", min=0, help=SEED_HELP),
@@ -91,6 +94,7 @@ def export(
     """Write a world as a mesh plus labels file that 'load_world' (and other tools) can read."""
     from seminspect.worlds import save_world
 
+    writable_directory(out)
     world = _generate(name, scenario, seed)
     save_world(world, out)
     summary = world.summary()

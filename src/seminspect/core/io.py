@@ -38,11 +38,19 @@ def _file_mode() -> int:
 _FILE_MODE = _file_mode()
 
 
+def _temporary_beside(target: Path, suffix: str) -> tuple[int, str]:
+    """A new temporary file in ``target``'s folder; an error names ``target``, not the temporary."""
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        return tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix, dir=target.parent)
+    except OSError as exc:
+        raise OSError(exc.errno, exc.strerror, str(target)) from None
+
+
 def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> Path:
     """Write ``data`` to ``path`` atomically (temporary file + fsync + rename)."""
     target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    fd, tmp_name = _temporary_beside(target, ".tmp")
     try:
         os.fchmod(fd, _FILE_MODE)
         with os.fdopen(fd, "wb") as handle:
@@ -61,10 +69,7 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[Path]:
     """Yield a temporary path beside ``path`` for a third-party writer; rename it over ``path``
     only when the block succeeds (the temporary file is removed otherwise)."""
     target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(
-        prefix=f".{target.name}.", suffix=target.suffix, dir=target.parent
-    )
+    fd, tmp_name = _temporary_beside(target, target.suffix)
     os.fchmod(fd, _FILE_MODE)
     os.close(fd)
     tmp = Path(tmp_name)
@@ -156,18 +161,22 @@ def read_json(path: str | os.PathLike[str], max_bytes: int = MAX_JSON_BYTES) -> 
 
 
 def read_versioned_json(
-    path: str | os.PathLike[str], kind: str, versions: Iterable[int]
+    path: str | os.PathLike[str],
+    kind: str,
+    versions: Iterable[int],
+    max_bytes: int = MAX_JSON_BYTES,
 ) -> dict[str, Any]:
     """Read a document written by :func:`write_versioned_json`, checking its kind and version."""
     supported = sorted(set(versions))
-    document = read_json(path)
+    document = read_json(path, max_bytes)
     if not isinstance(document, dict):
         raise FileFormatError(f"{path}: expected a JSON object, found {type(document).__name__}")
     found_kind = document.get("format")
     if found_kind != kind:
         raise FileFormatError(f"{path}: expected a {kind!r} file, found format {found_kind!r}")
     found_version = document.get("version")
-    if found_version not in supported:
+    # exact integers only: ``True == 1`` and ``1.0 == 1`` in Python, and neither is a version
+    if type(found_version) is not int or found_version not in supported:
         raise FileFormatError(
             f"{path}: {kind} version {found_version!r} is not supported (supported: {supported})"
         )

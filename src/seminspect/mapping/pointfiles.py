@@ -45,6 +45,8 @@ class PointData:
 def load_point_file(path: str | Path) -> PointData:
     """Read a ``.ply``, ``.pcd`` or ``.npz`` point file (by extension)."""
     source = Path(path)
+    if source.is_dir():
+        raise FileFormatError(f"{source}: is a directory, expected a point file")
     readers = {".ply": read_ply, ".pcd": read_pcd, ".npz": read_point_npz}
     reader = readers.get(source.suffix.lower())
     if reader is None:

@@ -382,6 +382,8 @@ def is_cloud_file(arrays: dict[str, NDArray]) -> bool:
 def read_npz(path: str | Path) -> dict[str, NDArray]:
     """Every array of an ``.npz`` (no pickles), or :class:`FileFormatError`."""
     source = Path(path)
+    if source.is_dir():
+        raise FileFormatError(f"{source}: is a directory, expected an .npz file")
     if not source.is_file():
         raise FileFormatError(f"{source}: no such file")
     try:
@@ -393,9 +395,12 @@ def read_npz(path: str | Path) -> dict[str, NDArray]:
 
 def cloud_from_arrays(source: Path, arrays: dict[str, NDArray]) -> SemanticCloud:
     """Validate the arrays of a saved cloud into a :class:`SemanticCloud`."""
-    version = int(arrays["version"]) if "version" in arrays else None
-    if version != CLOUD_VERSION:
-        raise FileFormatError(f"{source}: semantic cloud version {version} is not supported")
+    version = arrays.get("version")
+    # a whole-number scalar only: a string or float "version" is not one seminspect wrote
+    exact = version is not None and version.shape == () and version.dtype.kind in "iu"
+    if not exact or int(version) != CLOUD_VERSION:
+        found = None if version is None else version.tolist()
+        raise FileFormatError(f"{source}: semantic cloud version {found!r} is not supported")
     missing = [key for key in ("points", "embeddings", "counts", "encoder") if key not in arrays]
     if missing:
         raise FileFormatError(f"{source}: semantic cloud lacks {', '.join(missing)}")

@@ -88,7 +88,9 @@ class MissionConfig(_Strict):
         description="the robot waits for every planner call's wall time, so slow planning costs "
         "mission time (000 Sec VII-D); off by default because wall time varies between runs",
     )
-    time_budget_s: float | None = Field(None, gt=0, description="simulated seconds")
+    time_budget_s: float | None = Field(
+        None, gt=0, allow_inf_nan=False, description="simulated seconds"
+    )
     map_resolution: float = Field(0.3, ge=0.1, le=1.0, description="robot's occupancy map [m]")
     target_classes: tuple[str, ...] | None = None
     feature_labels: tuple[str, ...] | None = None
@@ -133,6 +135,8 @@ WORLD_DEFAULTS: dict[str, dict[str, Any]] = {
         "classes": ("building",), "features": BUILDING_FEATURES,
     },
 }  # fmt: skip
+#: A user world (``world`` is a path) takes the city's defaults; it has no scenarios.
+USER_WORLD_DEFAULTS = {k: v for k, v in WORLD_DEFAULTS["city"].items() if k != "scenario"}
 
 
 def make_config(values: dict[str, Any]) -> MissionConfig:
@@ -142,7 +146,7 @@ def make_config(values: dict[str, Any]) -> MissionConfig:
 
 def resolve(config: MissionConfig) -> MissionConfig:
     """Fill every ``None`` field with the world's default."""
-    defaults = WORLD_DEFAULTS.get(config.world, WORLD_DEFAULTS["city"])
+    defaults = WORLD_DEFAULTS.get(config.world, USER_WORLD_DEFAULTS)
     budget = defaults["budget"]
     inspection = config.inspection or InspectionConfig(d_view=defaults["d_view"])
     return config.model_copy(

@@ -2,8 +2,10 @@
 
 :func:`run_mission` builds the world, the simulated robot and the executive, runs it, answers
 the operator's queries, scores the result against the world's ground truth and writes
-everything to the run directory. A Ctrl-C or a failure mid-mission still writes the graph and
-metrics gathered so far and records why the run stopped; every file is written atomically.
+everything to the run directory. A Ctrl-C, a SIGTERM or a failure mid-mission still writes the
+graph and metrics gathered so far and records why the run stopped; every file is written
+atomically, and the last status is written after every output, so it never claims a file that
+is not there.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from seminspect.core.errors import SeminspectError
+from seminspect.core.interrupts import as_interrupted, deferred_signals, stop_on_signals
 from seminspect.mapping.voxel import VoxelMap
 from seminspect.missions.config import MissionConfig, inspection_params, resolve
 from seminspect.missions.evaluation import (
@@ -29,9 +32,10 @@ from seminspect.missions.evaluation import (
 from seminspect.missions.metrics import CpuMeter
 from seminspect.missions.platform import SimulatedPlatform, mission_noise
 from seminspect.missions.report import summary_markdown
-from seminspect.missions.rundir import RunDirectory
+from seminspect.missions.rundir import OUTPUT_FILES, RunDirectory
 from seminspect.missions.xflie import MissionProgress, XFlie
-from seminspect.worlds import World, generate_world
+from seminspect.worlds import World, open_world
+from seminspect.worlds.catalog import is_world_path
 
 
 @dataclass
@@ -58,20 +62,24 @@ class MissionResult:
     mission: XFlie
     world: World
     answers: list[QueryAnswer] = field(default_factory=list)
+    stop_signal: int | None = None  # the signal that interrupted the run, if one did
 
 
 def run_name(config: MissionConfig) -> str:
+    """``city-small-seed0``; a user world is named by its file or folder."""
+    world = Path(config.world).stem if is_world_path(config.world) else config.world
     scenario = f"-{config.scenario}" if config.scenario else ""
-    return f"{config.world}{scenario}-seed{config.seed}"
+    return f"{world}{scenario}-seed{config.seed}"
 
 
 def build_mission(
     config: MissionConfig,
     run: RunDirectory | None,
     progress: Callable[[MissionProgress], None] | None = None,
+    world: World | None = None,
 ) -> tuple[XFlie, World]:
-    """The world, the robot in it and the executive, ready to run."""
-    world = generate_world(config.world, config.scenario, seed=config.seed)
+    """The world (made from ``config`` unless given), the robot in it and the executive."""
+    world = world or open_world(config.world, config.scenario, seed=config.seed)
     params = inspection_params(config)
     # Ground robots carry the camera at body height; aerial ones start at Level-0's height.
     aerial = config.mode == "aerial"
@@ -109,42 +117,72 @@ def run_mission(
     queries: Sequence[str] = (),
     progress: Callable[[MissionProgress], None] | None = None,
 ) -> MissionResult:
-    """Run a mission into ``out`` (default: a fresh directory under ``base``)."""
+    """Run a mission into ``out`` (default: a fresh directory under ``base``).
+
+    The world is made first, so a bad world or scenario creates no directory. ``out`` is then
+    claimed (see :meth:`RunDirectory.claimed`): a second run on it fails at once, and files of an
+    earlier run in it are removed. Ctrl-C and SIGTERM end the mission as ``interrupted``.
+    """
     config = resolve(config)
-    run = RunDirectory(out) if out is not None else RunDirectory.fresh(base, run_name(config))
-    run.write_config(config.model_dump(mode="json"))
-    run.write_status("running")
-    mission, world = build_mission(config, run, progress)
+    world = open_world(config.world, config.scenario, seed=config.seed)
+    with stop_on_signals():
+        run = RunDirectory(out) if out is not None else RunDirectory.fresh(base, run_name(config))
+        with run.claimed(config.model_dump(mode="json")):
+            return _run(run, config, world, queries, progress)
+
+
+def _run(
+    run: RunDirectory,
+    config: MissionConfig,
+    world: World,
+    queries: Sequence[str],
+    progress: Callable[[MissionProgress], None] | None,
+) -> MissionResult:
+    mission, world = build_mission(config, run, progress, world)
     cpu = CpuMeter()
-    state, reason, error = "completed", "", None
+    state, reason, error, stop = "completed", "", None, None
     try:
         reason = mission.execute()
-    except KeyboardInterrupt:
-        state, reason = "interrupted", "interrupted by the operator (Ctrl-C)"
+    except KeyboardInterrupt as exc:
+        stop = as_interrupted(exc)
+        state, reason = "interrupted", stop.describe()
     except Exception as exc:  # recorded, then re-raised once the run directory is complete
         state, reason, error = "failed", f"{type(exc).__name__}: {exc}", exc
-    if mission.graph.inspecting is not None:
-        mission.graph.abort_inspection()
-    run.write_graph(mission.graph)  # first: the graph survives whatever fails below
     answers: list[QueryAnswer] = []
     metrics: dict[str, Any] = {}
     try:
+        if mission.graph.inspecting is not None:
+            mission.graph.abort_inspection()
+        run.write_graph(mission.graph)  # first: the graph survives whatever fails below
         answers = answer_queries(mission, queries) if state == "completed" else []
         metrics = mission_metrics(mission, world, cpu, state=state, reason=reason, answers=answers)
         _write_outputs(run, mission, metrics, answers)
+    except KeyboardInterrupt as exc:
+        stop = stop or as_interrupted(exc)
+        state, reason = "interrupted", _cut_short(run, reason, stop.describe())
     except Exception as exc:
         failure = f"finishing the run failed: {type(exc).__name__}: {exc}"
-        state, reason = "failed", f"{reason}; {failure}" if reason else failure
+        state, reason = "failed", _cut_short(run, reason, failure)
         error = error or exc
-    finally:
-        run.write_status(state, reason, run_dir=str(run.root))
+    with deferred_signals():  # a second signal must not cut the last status short
+        run.finish(state, reason)
     if error is not None:
         if isinstance(error, SeminspectError):
             raise error
         raise SeminspectError(
             f"mission failed ({reason}); partial results in {run.root}"
         ) from error
-    return MissionResult(run.root, state, reason, metrics, mission, world, answers)
+    signum = stop.signum if stop else None
+    return MissionResult(run.root, state, reason, metrics, mission, world, answers, signum)
+
+
+def _cut_short(run: RunDirectory, reason: str, why: str) -> str:
+    """The reason of a run stopped while writing its outputs, naming the ones not written."""
+    missing = [name for name in OUTPUT_FILES if not run.path(name).exists()]
+    note = f"{why} while writing the outputs" + (
+        f"; not written: {', '.join(missing)}" if missing else ""
+    )
+    return f"{reason}; {note}" if reason else note
 
 
 def answer_queries(mission: XFlie, queries: Sequence[str]) -> list[QueryAnswer]:
@@ -286,7 +324,6 @@ def _write_outputs(
 ) -> None:
     run.write_graph(mission.graph)
     run.write_map(mission.occupancy)
-    run.write_metrics(metrics)
     trajectory = mission.platform.robot.trajectory if hasattr(mission.platform, "robot") else None
     if trajectory is not None:
         rows = np.column_stack(
@@ -301,3 +338,4 @@ def _write_outputs(
         run.write_trajectory(rows.tolist())
     run.flush_events()
     run.write_summary(summary_markdown(metrics, mission.graph, answers))
+    run.write_metrics(metrics)  # last: its presence says every output before it was written

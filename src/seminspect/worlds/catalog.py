@@ -2,14 +2,17 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.names import unknown_name
 from seminspect.worlds import campus, city, collapsed, outdoor, rooms
 from seminspect.worlds.underground import generate_mine_drift, generate_subterranean
+from seminspect.worlds.user import LABELS_SUFFIXES, MESH_SUFFIXES, load_world_path
 from seminspect.worlds.world import World
 
 
@@ -124,3 +127,21 @@ def generate_world(name: str, scenario: str | None = None, seed: int = 0, **opti
         {"generator": name, "scenario": chosen, "options": {**spec.options, **options}}
     )
     return world
+
+
+def open_world(name_or_path: str, scenario: str | None = None, seed: int = 0) -> World:
+    """A built-in world by name, or a user world by path (see ``worlds.user.load_world_path``);
+    a user world is fixed, so it takes no scenario and ignores ``seed``."""
+    if name_or_path in WORLDS:
+        return generate_world(name_or_path, scenario, seed)
+    if not is_world_path(name_or_path):
+        raise unknown_name("world", name_or_path, WORLDS, "(nor a world file path)")
+    if scenario is not None:
+        raise InvalidInputError(f"{name_or_path} is a user world, which has no scenarios")
+    return load_world_path(name_or_path)
+
+
+def is_world_path(text: str) -> bool:
+    """Whether ``text`` names a file or folder rather than a built-in world."""
+    suffix = Path(text).suffix.lower()
+    return os.sep in text or suffix in MESH_SUFFIXES + LABELS_SUFFIXES or Path(text).exists()

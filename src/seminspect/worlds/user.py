@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, Literal
 
@@ -47,6 +48,7 @@ from seminspect.worlds.world import BACKGROUND, World
 LABELS_FORMAT = "seminspect-world-labels"
 LABELS_VERSION = 1
 MESH_SUFFIXES = (".obj", ".ply", ".glb", ".gltf", ".stl", ".off")
+LABELS_SUFFIXES = (".json", ".yaml", ".yml")
 #: Refuse meshes above this size before parsing them.
 MAX_MESH_BYTES = 512 << 20
 
@@ -310,6 +312,39 @@ def load_world(mesh_path: str | os.PathLike[str], labels_path: str | os.PathLike
         return builder.build(bounds, start.position, start.yaw, metadata)
     except InvalidInputError as exc:
         raise FileFormatError(f"{source}: {exc}") from None
+
+
+def load_world_path(path: str | os.PathLike[str]) -> World:
+    """A user world named by one path: a directory holding a labels file and one mesh (what
+    :func:`save_world` writes), a labels file with one mesh beside it, or a mesh with one
+    labels file beside it."""
+    source = Path(path)
+    if not source.exists():
+        raise FileFormatError(f"{source}: no such world file or directory")
+    folder = source if source.is_dir() else source.parent
+    meshes = [source] if _is_mesh(source) else _beside(folder, _is_mesh, "mesh", source)
+    labels = [source] if _is_labels(source) else _beside(folder, _is_labels, "labels file", source)
+    return load_world(meshes[0], labels[0])
+
+
+def _is_mesh(path: Path) -> bool:
+    return path.is_file() and path.suffix.lower() in MESH_SUFFIXES
+
+
+def _is_labels(path: Path) -> bool:
+    return path.is_file() and path.suffix.lower() in LABELS_SUFFIXES
+
+
+def _beside(folder: Path, wanted: Callable[[Path], bool], kind: str, given: Path) -> list[Path]:
+    """The one file of ``kind`` in ``folder``, or an error saying what a world path is."""
+    found = sorted(p for p in folder.iterdir() if wanted(p))
+    if len(found) != 1:
+        what = "none" if not found else ", ".join(p.name for p in found)
+        raise FileFormatError(
+            f"{given}: a user world needs exactly one {kind} in {folder} (found {what}); "
+            "see 'seminspect world export' for the layout"
+        )
+    return found
 
 
 def _add_labelled(builder: WorldBuilder, vertices, faces, labels: tuple[NDArray, ...]) -> None:

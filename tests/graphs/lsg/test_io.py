@@ -7,6 +7,7 @@ from hypothesis import HealthCheck, given, settings
 
 from lsg_strategies import climbing_graphs, layered_graphs
 from seminspect.core.errors import FileFormatError, InvalidInputError
+from seminspect.graphs.lsg import io as lsg_io
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.io import (
     export_graphml,
@@ -159,3 +160,33 @@ def test_open_rings_and_realised_level_edges_survive_a_round_trip(
 def test_a_graph_without_open_rings_or_level_routes_is_written_as_before(saved: dict) -> None:
     levels = [level for target in saved["targets"] for level in target["levels"]]
     assert levels and all("ring" not in level and "via" not in level for level in levels)
+
+
+def test_files_over_the_size_limit_are_refused_before_reading(tmp_path, saved, monkeypatch) -> None:
+    path = tmp_path / "big.json"
+    path.write_text(json.dumps(saved))
+    monkeypatch.setattr(lsg_io, "MAX_GRAPH_BYTES", path.stat().st_size - 1)
+    with pytest.raises(FileFormatError, match="byte limit"):
+        load_graph(path)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ('{"format": "seminspect.lsg", "version": 1, "params": {"a": NaN}}', "non-standard JSON"),
+        ('{"format": "seminspect.lsg", "version": 1, "targets": {}}', "expected a list of targets"),
+        ("[" * 100_000, "nested too deeply"),
+        ('{"format": "seminspect.other", "version": 1}', "found format 'seminspect.other'"),
+        ('{"format": "seminspect.lsg", "version": 1.0}', "version 1.0 is not supported"),
+        ('{"format": "seminspect.lsg", "version": true}', "version True is not supported"),
+        ("\xff\xfe", "not UTF-8"),
+    ],
+)
+def test_hostile_json_is_one_clear_line(tmp_path, text, message) -> None:
+    path = tmp_path / "hostile.json"
+    path.write_bytes(text.encode("latin-1"))
+    with pytest.raises(FileFormatError, match=message) as info:
+        load_graph(path)
+    assert "\n" not in str(info.value)
+    with pytest.raises(FileFormatError, match="is a directory"):
+        load_graph(tmp_path)

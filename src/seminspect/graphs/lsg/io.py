@@ -51,6 +51,9 @@ FORMAT = "seminspect.lsg"
 VERSION = 1
 #: Structural limits that keep a hostile file from exhausting memory.
 MAX_ITEMS = 1_000_000
+#: Largest graph file loaded (~17,000 inspected vehicles of 20 views each); see
+#: docs/scene-graph.md for the memory a load takes (measured by bench/graph_io.py).
+MAX_GRAPH_BYTES = 256 << 20
 
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Vec2 = Annotated[list[float], Field(min_length=2, max_length=2)]
@@ -124,14 +127,19 @@ class RobotRecord(_Record):
     stamp: float = 0.0
 
 
-class GraphDocument(_Record):
+class GraphHeader(_Record):
+    """Everything in a graph file but its targets (:func:`load_graph` takes those one by one)."""
+
     format: Literal["seminspect.lsg"] = FORMAT
     version: Literal[1] = VERSION
     params: dict[str, float | int]
     robot: RobotRecord
     next_target_index: Annotated[int, Field(ge=0)]
-    targets: Annotated[list[TargetRecord], Field(max_length=MAX_ITEMS)]
     target_edges: Annotated[list[TargetEdgeRecord], Field(max_length=MAX_ITEMS)] = []
+
+
+class GraphDocument(GraphHeader):
+    targets: Annotated[list[TargetRecord], Field(max_length=MAX_ITEMS)]
 
 
 # ---------------------------------------------------------------------- saving
@@ -226,38 +234,66 @@ def save_graph(graph: LayeredSemanticGraph, path: str | os.PathLike[str]) -> Pat
 
 # ---------------------------------------------------------------------- loading
 def load_graph(path: str | os.PathLike[str]) -> LayeredSemanticGraph:
-    """Read a graph written by :func:`save_graph`; any defect raises :class:`FileFormatError`."""
-    raw = read_versioned_json(path, FORMAT, [VERSION])
+    """Read a graph written by :func:`save_graph`; any defect raises :class:`FileFormatError`.
+
+    Files above :data:`MAX_GRAPH_BYTES` are refused before they are read. Targets are validated
+    and rebuilt one at a time, each dropping its part of the parsed file, so memory peaks near
+    the parsed JSON rather than the JSON plus a validated copy plus the graph.
+    """
+    raw = read_versioned_json(path, FORMAT, [VERSION], max_bytes=MAX_GRAPH_BYTES)
+    targets = raw.pop("targets", None)
+    if not isinstance(targets, list) or len(targets) > MAX_ITEMS:
+        raise FileFormatError(f"{path}: invalid graph file at targets: expected a list of targets")
     try:
-        document = GraphDocument.model_validate(raw)
+        header = GraphHeader.model_validate(raw)
+        graph = _start_graph(header)
+        for index in range(len(targets)):
+            record, targets[index] = _target_at(targets, index), None
+            _restore_target(graph, record)
+        return _finish_graph(graph, header)
     except ValidationError as exc:
         raise FileFormatError(f"{path}: {_first_error(exc)}") from None
-    try:
-        return graph_from_document(document)
     except SeminspectError as exc:
         raise FileFormatError(f"{path}: {exc}") from None
 
 
-def _first_error(exc: ValidationError) -> str:
+def _target_at(targets: list[Any], index: int) -> TargetRecord:
+    try:
+        return TargetRecord.model_validate(targets[index])
+    except ValidationError as exc:
+        raise FileFormatError(_first_error(exc, ("targets", index))) from None
+
+
+def _first_error(exc: ValidationError, within: tuple[str | int, ...] = ()) -> str:
     error = exc.errors()[0]
-    where = ".".join(str(part) for part in error["loc"]) or "document"
+    where = ".".join(str(part) for part in (*within, *error["loc"])) or "document"
     return f"invalid graph file at {where}: {error['msg']}"
 
 
 def graph_from_document(document: GraphDocument) -> LayeredSemanticGraph:
     """Rebuild a graph from a validated document (structure checked as it is rebuilt)."""
-    robot = document.robot
-    graph = LayeredSemanticGraph(make_params(document.params), robot.position)
-    graph.robot.orientation = _unit(robot.orientation, "the robot")
-    graph.robot.stamp = robot.stamp
+    graph = _start_graph(document)
     for record in document.targets:
         _restore_target(graph, record)
-    for edge in document.target_edges:  # ``via`` is stored oriented from ``a`` to ``b``
+    return _finish_graph(graph, document)
+
+
+def _start_graph(header: GraphHeader) -> LayeredSemanticGraph:
+    robot = header.robot
+    graph = LayeredSemanticGraph(make_params(header.params), robot.position)
+    graph.robot.orientation = _unit(robot.orientation, "the robot")
+    graph.robot.stamp = robot.stamp
+    return graph
+
+
+def _finish_graph(graph: LayeredSemanticGraph, header: GraphHeader) -> LayeredSemanticGraph:
+    """The Target-layer edges and the index counter, once every target is in."""
+    for edge in header.target_edges:  # ``via`` is stored oriented from ``a`` to ``b``
         graph.connect_targets(edge.a, edge.b, edge.via)
     indices = [t.index for t in graph.targets()]
-    if indices and document.next_target_index <= max(indices):
+    if indices and header.next_target_index <= max(indices):
         raise InvalidInputError("next_target_index must exceed every target index")
-    graph.next_target_index = document.next_target_index
+    graph.next_target_index = header.next_target_index
     return graph
 
 

@@ -1,0 +1,101 @@
+"""Stop signals as exceptions: Ctrl-C (SIGINT) and SIGTERM end work the same way.
+
+SIGTERM is what ``timeout``, systemd, ``docker stop`` and CI cancellation send. Python's default
+is to die on the spot, leaving whatever was being written claiming to be in progress; inside
+:func:`stop_on_signals` both signals raise :class:`Interrupted` instead, so ``finally`` blocks
+record why the work stopped. :func:`deferred_signals` holds them back for a few lines that must
+not be cut in half (the last status of a run directory).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+from collections.abc import Iterator
+from types import FrameType
+
+#: The signals that ask a run to stop, and how a person would name them.
+STOP_SIGNALS: dict[int, str] = {
+    signal.SIGINT: "interrupted by the operator (Ctrl-C)",
+    signal.SIGTERM: "stopped by SIGTERM",
+}
+
+
+class Interrupted(KeyboardInterrupt):
+    """Raised when a stop signal arrives; a ``KeyboardInterrupt`` so existing handlers apply."""
+
+    def __init__(self, signum: int = signal.SIGINT) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+    @property
+    def exit_code(self) -> int:
+        """The shell's convention: 128 plus the signal number (130 for Ctrl-C, 143 for SIGTERM)."""
+        return 128 + self.signum
+
+    def describe(self) -> str:
+        return STOP_SIGNALS.get(self.signum, f"stopped by signal {self.signum}")
+
+
+def as_interrupted(exc: KeyboardInterrupt) -> Interrupted:
+    """A plain ``KeyboardInterrupt`` (raised by Python's own handler) is a Ctrl-C."""
+    return exc if isinstance(exc, Interrupted) else Interrupted(signal.SIGINT)
+
+
+class _Handler:
+    """Raise :class:`Interrupted`, or remember the signal while raising is deferred."""
+
+    def __init__(self) -> None:
+        self.deferring = 0
+        self.pending: int | None = None
+
+    def __call__(self, signum: int, frame: FrameType | None) -> None:
+        if self.deferring:
+            self.pending = self.pending or signum
+            return
+        raise Interrupted(signum)
+
+
+class _Installed:
+    """The handler :func:`stop_on_signals` installed, if any (one per process)."""
+
+    handler: _Handler | None = None
+
+
+@contextlib.contextmanager
+def stop_on_signals() -> Iterator[None]:
+    """Turn SIGINT and SIGTERM into :class:`Interrupted` inside the block.
+
+    Outside the main thread signal handlers cannot be installed; the block then runs unchanged
+    (Python still raises ``KeyboardInterrupt`` for Ctrl-C in the main thread).
+    """
+    if threading.current_thread() is not threading.main_thread() or _Installed.handler:
+        yield
+        return
+    handler = _Handler()
+    previous = {signum: signal.signal(signum, handler) for signum in STOP_SIGNALS}
+    _Installed.handler = handler
+    try:
+        yield
+    finally:
+        _Installed.handler = None
+        for signum, old in previous.items():
+            signal.signal(signum, old)
+
+
+@contextlib.contextmanager
+def deferred_signals() -> Iterator[None]:
+    """Hold stop signals back until the block ends, then raise the first one that arrived."""
+    handler = _Installed.handler
+    if handler is None:
+        yield
+        return
+    handler.deferring += 1
+    try:
+        yield
+    finally:
+        handler.deferring -= 1
+        if not handler.deferring and handler.pending is not None:
+            signum, handler.pending = handler.pending, None
+            raise Interrupted(signum)

@@ -1,0 +1,25 @@
+import os
+import signal
+
+import pytest
+
+from seminspect.core.interrupts import Interrupted, deferred_signals, stop_on_signals
+
+
+@pytest.mark.parametrize(("signum", "code"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_a_stop_signal_raises_interrupted_with_the_shells_exit_code(signum, code) -> None:
+    previous = signal.getsignal(signum)
+    with pytest.raises(Interrupted) as caught, stop_on_signals():
+        os.kill(os.getpid(), signum)
+    assert caught.value.signum == signum and caught.value.exit_code == code
+    assert isinstance(caught.value, KeyboardInterrupt)
+    assert signal.getsignal(signum) is previous  # handlers restored
+
+
+def test_a_signal_during_a_deferred_block_arrives_after_it() -> None:
+    finished = []
+    with pytest.raises(Interrupted) as caught, stop_on_signals(), deferred_signals():
+        os.kill(os.getpid(), signal.SIGTERM)
+        finished.append("last status written")
+    assert finished == ["last status written"] and caught.value.signum == signal.SIGTERM
+    assert "SIGTERM" in caught.value.describe()
