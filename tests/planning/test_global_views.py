@@ -47,7 +47,12 @@ def test_only_intersections_inside_the_polygon_are_kept():
 
 def test_views_face_the_surface_from_d_view_on_the_free_side():
     plan = global_view_plan(
-        InspectionRegion("r", RECT), wall_map(), VIEW, robot_radius=0.3, height_limits=(0.3, 3.7)
+        InspectionRegion("r", RECT),
+        wall_map(),
+        VIEW,
+        robot_radius=0.3,
+        height_limits=(0.3, 3.7),
+        viewer=(1, 3, 1),
     )
     assert len(plan.positions) == 12 and plan.dropped == 0 and plan.repaired == 0
     np.testing.assert_allclose(plan.positions[:, 0], 8.0)
@@ -63,6 +68,7 @@ def test_a_pose_inside_an_obstacle_is_repaired_or_dropped():
         VIEW,
         robot_radius=0.3,
         height_limits=(0.3, 3.7),
+        viewer=(1, 3, 1),
     )
     assert plan.repaired + plan.dropped == 4
     prior = wall_map([pillar])
@@ -88,3 +94,14 @@ def test_contains_uses_outline_and_slab():
     region = InspectionRegion("r", RECT)
     inside = region.contains([[10.2, 2.0, 1.0], [10.2, 0.5, 1.0], [11.0, 2.0, 1.0]], slab=0.5)
     assert inside.tolist() == [True, False, False]
+
+
+def test_without_free_space_the_views_face_the_viewer():
+    surface_only = VoxelMap.from_boxes([0, 0, 0], [12, 6, 4], 0.1, [[[10, 0, 0], [10.1, 6, 4]]])
+    surface_only.states[surface_only.states == 1] = 0  # a point cloud: occupied or unknown
+    region = InspectionRegion("r", RECT)
+    for viewer, x in (((1, 3, 1), 8.0), ((11.5, 3, 1), 12.0)):
+        plan = global_view_plan(
+            region, surface_only, VIEW, robot_radius=0.3, height_limits=(0.3, 3.7), viewer=viewer
+        )
+        np.testing.assert_allclose(plan.positions[:, 0], x)

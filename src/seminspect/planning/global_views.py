@@ -145,17 +145,23 @@ def _centred_lines(low: float, high: float, spacing: float) -> NDArray[np.float6
     return middle + spacing * (np.arange(count) - (count - 1) / 2)
 
 
-def outward_normal(region: InspectionRegion, prior: VoxelMap, d_view: float) -> NDArray:
-    """The normal pointing into free space on ``M_H``: the side with more free cells along the
-    normal between 0.3 m and ``d_view`` from the centroid."""
+def outward_normal(
+    region: InspectionRegion, prior: VoxelMap, d_view: float, viewer: ArrayLike
+) -> NDArray[np.float64]:
+    """The normal pointing into free space on ``M_H``: the side with more free than occupied
+    cells along the normal between 0.3 m and ``d_view`` from the centroid; on a tie (a map
+    without free space, such as a point cloud) the side facing ``viewer``."""
     _, _, n = region.frame()
     probes = np.linspace(0.3, d_view, 8)[:, None]
 
-    def free_count(direction: NDArray[np.float64]) -> int:
+    def openness(direction: NDArray[np.float64]) -> int:
         states = prior.state_at(region.centroid + probes * direction)
-        return int((states == FREE).sum())
+        return int((states == FREE).sum()) - int((states == OCCUPIED).sum())
 
-    return n if free_count(n) >= free_count(-n) else -n
+    ahead, behind = openness(n), openness(-n)
+    if ahead == behind:
+        return n if float((np.asarray(viewer) - region.centroid) @ n) >= 0 else -n
+    return n if ahead > behind else -n
 
 
 def pose_is_clear(prior: VoxelMap, point: NDArray[np.float64], radius: float) -> bool:
@@ -175,9 +181,11 @@ def global_view_plan(
     *,
     robot_radius: float,
     height_limits: tuple[float, float],
+    viewer: ArrayLike,
 ) -> ViewPlan:
-    """``GenerateGlobalViewPlan`` and ``UpdatePlan`` of Algorithm 1 for one region (Fig 3)."""
-    normal = outward_normal(region, prior, constraints.d_view)
+    """``GenerateGlobalViewPlan`` and ``UpdatePlan`` of Algorithm 1 for one region (Fig 3);
+    ``viewer`` (the robot's start) breaks ties in :func:`outward_normal`."""
+    normal = outward_normal(region, prior, constraints.d_view, viewer)
     horizontal = normal.copy()
     horizontal[2] = 0.0
     horizontal /= np.linalg.norm(horizontal)
