@@ -56,3 +56,13 @@ def test_reference_solver_agrees_with_brute_force():
     tour = reference_tour([0, 0, 0], points)
     assert sorted(tour.order.tolist()) == list(range(7))
     assert tour.length == pytest.approx(brute_force([0, 0, 0], points), abs=0.01)
+
+
+def test_reference_solver_keeps_its_dummy_next_to_the_start_on_large_grids():
+    pytest.importorskip("elkai")
+    u, v = np.meshgrid(np.arange(11) * 1.1, np.arange(7) * 0.66, indexing="ij")
+    points = np.column_stack([np.zeros(u.size), u.ravel(), v.ravel()])
+    reference = reference_tour([0, -2, 0], points)
+    assert sorted(reference.order.tolist()) == list(range(len(points)))
+    annealed = annealed_tour([0, -2, 0], points, make_rng(0, "test"))
+    assert reference.length <= annealed.length + 1e-6

@@ -137,7 +137,7 @@ def reference_tour(start: ArrayLike, points: ArrayLike, runs: int = 10) -> Tour:
         return _best_small(distances)
     closed = np.zeros((n + 2, n + 2))
     closed[: n + 1, : n + 1] = distances
-    closed[n + 1, 1:] = closed[1:, n + 1] = distances.sum() + 1.0
+    closed[n + 1, 1:] = closed[1:, n + 1] = (n + 1) * distances.max() + 1.0
     closed[n + 1, n + 1] = 0.0
     cycle = elkai.DistanceMatrix(np.rint(closed * 1000).astype(int).tolist()).solve_tsp(runs)
     return Tour(*_open_from_cycle(cycle, n, distances))
