@@ -119,11 +119,10 @@ def changes_figure(run_dir: Path) -> Figure | None:
     band = (heights > WALL_BAND_M[0]) & (heights < WALL_BAND_M[1])  # no floor, no roof
     walls = (prior.states[:, :, band] == OCCUPIED).any(axis=2).T
     ax.imshow(walls, origin="lower", extent=extent, cmap="Greys", alpha=0.35, aspect="equal")
-    for mask, colour, name in ((added, "Reds", "added"), (removed, "Blues", "removed")):
-        column = mask.sum(axis=2).T.astype(float)
-        shown = np.ma.masked_where(column == 0, column)
-        ax.imshow(shown, origin="lower", extent=extent, cmap=colour, aspect="equal", alpha=0.9)
-        ax.plot([], [], color=colour.lower()[:-1], linewidth=6, label=f"{name} in M_C")
+    for mask, colour, name in ((added, "tab:red", "added"), (removed, "tab:blue", "removed")):
+        columns = np.argwhere(mask[:, :, band].any(axis=2))
+        centres = prior.index_to_world(np.column_stack([columns, np.zeros(len(columns))]))
+        ax.scatter(centres[:, 0], centres[:, 1], s=4, color=colour, label=f"{name} in M_C")
     _draw_tours(ax, run_dir)
     trajectory = load_trajectory(run_dir)
     if len(trajectory):
@@ -142,7 +141,7 @@ def _draw_tours(ax, run_dir: Path) -> None:
     for task in read_versioned_json(path, TOUR_FORMAT, [1])["tasks"]:
         region = np.array(task["region"] + task["region"][:1])
         views = np.array(task["views"]).reshape(-1, 3)
-        ax.plot(region[:, 0], region[:, 1], color="black", linewidth=2)
+        ax.plot(region[:, 0], region[:, 1], color="black", linewidth=1, linestyle="--")
         ax.scatter(views[:, 0], views[:, 1], s=12, color="tab:orange", zorder=3)
         ax.annotate(task["task"], region[0, :2], fontsize=8)
 
