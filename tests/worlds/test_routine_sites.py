@@ -83,3 +83,15 @@ def test_bad_drift_options_are_refused():
 
     with pytest.raises(InvalidInputError, match="face advance"):
         drift_world(0, 12.0, face_advance=7.0)
+
+
+def test_world_directories_need_one_mesh_and_one_labels_file(tmp_path):
+    from seminspect.worlds.routine_sites import world_files
+
+    with pytest.raises(InvalidInputError, match="not a directory"):
+        world_files(tmp_path / "missing")
+    (tmp_path / "world.ply").write_text("ply\n")
+    with pytest.raises(InvalidInputError, match="labels"):
+        world_files(tmp_path)
+    (tmp_path / "labels.json").write_text("{}")
+    assert [p.name for p in world_files(tmp_path)] == ["world.ply", "labels.json"]

@@ -16,6 +16,30 @@ _SCENARIO = typer.Option(
 )
 _SEED = typer.Option(0, "--seed", help="Seed of the site and the tour.", min=0)
 _LENGTH = typer.Option(20.0, "--length", help="Drift length [m].", min=10, max=200)
+_HISTORICAL = typer.Option(
+    None,
+    "--historical",
+    help="Your own site as first mapped: a directory with world.<mesh> and labels.json "
+    "(as 'seminspect world export' writes); replaces --world/--scenario.",
+)
+_CURRENT = typer.Option(
+    None, "--current", help="Your own site as it is now (same layout as --historical)."
+)
+
+
+def _config_and_site(world, scenario, seed, length, historical, current, *, need_current=True):
+    """The settings, and the user's site pair when --historical/--current are given."""
+    from seminspect.core.errors import InvalidInputError
+    from seminspect.missions.routine import RoutineConfig
+    from seminspect.worlds.routine_sites import user_site, world_files
+
+    if historical is None and current is None:
+        return RoutineConfig(world=world, scenario=scenario, seed=seed, length=length), None
+    if historical is None or (need_current and current is None):
+        raise InvalidInputError("--historical and --current go together")
+    before = world_files(historical)
+    site = user_site(before, world_files(current) if current is not None else before)
+    return RoutineConfig(world="user", scenario="user", seed=seed, length=length), site
 
 
 def _progress_bar():
@@ -36,16 +60,18 @@ def map_command(
     scenario: str = _SCENARIO,
     seed: int = _SEED,
     length: float = _LENGTH,
+    historical: Path | None = _HISTORICAL,
     out: Path = typer.Option(..., "--out", "-o", help="Directory for the map (map.npz)."),
 ) -> None:
     """Record M_H: a mapping traverse through the scenario's historical world."""
-    from seminspect.missions.routine import RoutineConfig
     from seminspect.missions.routine_run import map_site
 
-    config = RoutineConfig(world=world, scenario=scenario, seed=seed, length=length)
+    config, site = _config_and_site(
+        world, scenario, seed, length, historical, None, need_current=False
+    )
     with _progress_bar() as bar:
         task = bar.add_task("mapping M_H", total=1.0)
-        path = map_site(config, out, lambda share: bar.update(task, completed=share))
+        path = map_site(config, out, lambda share: bar.update(task, completed=share), site)
     console.print(f"M_H recorded: {path}")
     console.print(f"inspect with: seminspect routine inspect --scenario {scenario} --prior {path}")
 
@@ -56,6 +82,8 @@ def inspect_command(
     scenario: str = _SCENARIO,
     seed: int = _SEED,
     length: float = _LENGTH,
+    historical: Path | None = _HISTORICAL,
+    current: Path | None = _CURRENT,
     prior: Path | None = typer.Option(
         None, "--prior", help="M_H (.npz, .bt, .ply, .pcd); default: record it first."
     ),
@@ -72,12 +100,11 @@ def inspect_command(
     pictures: bool = typer.Option(True, "--pictures/--no-pictures", help="Draw the pictures."),
 ) -> None:
     """Inspect the scenario's regions in the current world with a plan made on M_H."""
-    from seminspect.missions.routine import RoutineConfig
     from seminspect.missions.routine_run import PRIOR_FILE, run_routine
     from seminspect.report.figures import save_figure
     from seminspect.report.routine import comparison_figure, render_routine
 
-    base = RoutineConfig(world=world, scenario=scenario, seed=seed, length=length)
+    base, site = _config_and_site(world, scenario, seed, length, historical, current)
     runs = {"adaptive": True, "baseline": False} if compare else {"": adapt}
     results = {}
     shared_prior = prior
@@ -91,7 +118,7 @@ def inspect_command(
             config = base.model_copy(update={"adapt": adaptive})
             run_dir = out / name if name else out
             result = run_routine(
-                config, run_dir, prior_path=shared_prior, tasks_path=tasks, progress=show
+                config, run_dir, prior_path=shared_prior, tasks_path=tasks, progress=show, site=site
             )
             results[name] = result
             if shared_prior is None and (run_dir / PRIOR_FILE).exists():

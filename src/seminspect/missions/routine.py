@@ -48,7 +48,7 @@ from seminspect.missions.routine_measures import (
     seen_samples,
     view_distance,
 )
-from seminspect.planning.adaptive import plan_cycle
+from seminspect.planning.adaptive import CycleDecision, plan_cycle
 from seminspect.planning.global_views import (
     InspectionRegion,
     ViewPlan,
@@ -141,15 +141,17 @@ def record_prior(
     world: World, config: RoutineConfig, progress: Callable[[float], None] | None = None
 ) -> VoxelMap:
     """``M_H``: a traverse down the drift's centre line, a LiDAR scan and three camera frames
-    (ahead, left, right) integrated every metre."""
+    (ahead, left, right) integrated every metre. In a user's world the traverse runs along
+    +x from the start to 4 m short of the world's end, stopping where something blocks it."""
     prior = VoxelMap.covering(world, config.map_resolution)
     robot = make_robot(world, config)
     camera = config.camera()
     start = robot.position.copy()
     end_x = float(world.metadata.get("face_x", world.bounds[1][0])) - 4.0
-    stops = np.arange(start[0], end_x + 1e-9, SENSE_EVERY_M)
+    stops = np.arange(start[0], max(end_x, start[0]) + 1e-9, SENSE_EVERY_M)
     for count, x in enumerate(stops):
-        robot.move_to([x, start[1], start[2]], 0.0)
+        if robot.move_to([x, start[1], start[2]], 0.0).blocked:
+            break
         sense(robot, world, prior)
         for yaw in (0.0, math.pi / 2, -math.pi / 2):
             frame = render(world, camera, robot.position, quat_from_yaw(yaw), stride=4)
@@ -410,7 +412,7 @@ class RoutineMission:
         self.samples.append(self._sample(plan, k, decision, frame))
         return True
 
-    def _sample(self, plan: ViewPlan, k: int, decision, frame: Frame) -> ViewSample:
+    def _sample(self, plan: ViewPlan, k: int, decision: CycleDecision, frame: Frame) -> ViewSample:
         x, y, z = self.robot.position
         return ViewSample(
             t=self.robot.time,

@@ -56,6 +56,7 @@ class RoutineResult:
 
 
 def routine_site(config: RoutineConfig) -> SitePair:
+    """The config's built-in site pair (user pairs are passed to :func:`run_routine`)."""
     if config.world != "mine-drift":
         raise InvalidInputError(
             f"routine scenarios exist for the mine drift only, got world {config.world!r}"
@@ -64,10 +65,14 @@ def routine_site(config: RoutineConfig) -> SitePair:
 
 
 def map_site(
-    config: RoutineConfig, out: str | os.PathLike[str], progress: Callable[[float], None] | None
+    config: RoutineConfig,
+    out: str | os.PathLike[str],
+    progress: Callable[[float], None] | None,
+    site: SitePair | None = None,
 ) -> Path:
-    """``routine map``: record ``M_H`` of the scenario's historical world into ``out/map.npz``."""
-    site = routine_site(config)
+    """``routine map``: record ``M_H`` of the historical world (the scenario's, or ``site``'s)
+    into ``out/map.npz``."""
+    site = site if site is not None else routine_site(config)
     run = RunDirectory(out)
     run.write_config({"routine_map": config.model_dump(mode="json")})
     run.write_status("running")
@@ -79,7 +84,7 @@ def map_site(
     path = run.write_map(prior)
     counts = prior.counts()
     run.write_summary(
-        f"# M_H of mine-drift {config.scenario}, seed {config.seed}\n\n"
+        f"# M_H of {config.world} {config.scenario}, seed {config.seed}\n\n"
         f"{counts['occupied']} occupied, {counts['free']} free, {counts['unknown']} unknown "
         f"cells of {prior.resolution:g} m.\n"
     )
@@ -94,9 +99,13 @@ def run_routine(
     prior_path: str | os.PathLike[str] | None = None,
     tasks_path: str | os.PathLike[str] | None = None,
     progress: Callable[[str, float], None] | None = None,
+    site: SitePair | None = None,
 ) -> RoutineResult:
-    """``routine inspect``: record or load ``M_H``, run Algorithm 1, write the run directory."""
-    site = routine_site(config)
+    """``routine inspect``: record or load ``M_H``, run Algorithm 1, write the run directory.
+
+    ``site`` replaces the config's built-in site (a user pair, ``routine_sites.user_site``).
+    """
+    site = site if site is not None else routine_site(config)
     regions = load_tasks(tasks_path) if tasks_path is not None else default_tasks(site)
     run = RunDirectory(out)
     settings = {

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -105,6 +106,24 @@ def mine_drift_site(scenario: str, seed: int, length: float = DEFAULT_LENGTH) ->
     change = {"kind": "obstructed", "rockfall_x_m": [x, x + 1.2], "gap_m": ROCKFALL_GAP_M}
     tasks = (("wall", wall_region(0.25 * length, 0.4 * length)), ("face", face_region(length)))
     return SitePair(scenario, seed, plain, current, change, tasks)
+
+
+def world_files(directory: str | os.PathLike[str]) -> tuple[Path, Path]:
+    """The ``(mesh, labels)`` files of a world directory: ``world.<mesh format>`` beside
+    ``labels.json`` (or ``.yaml``/``.yml``), as ``seminspect world export`` writes them."""
+    root = Path(directory)
+    if not root.is_dir():
+        raise InvalidInputError(f"{root} is not a directory with world.<mesh> and labels.json")
+    labels = [
+        p for p in (root / f"labels{ext}" for ext in (".json", ".yaml", ".yml")) if p.exists()
+    ]
+    meshes = sorted(p for p in root.glob("world.*") if p.suffix.lower() != ".json")
+    if len(labels) != 1 or len(meshes) != 1:
+        raise InvalidInputError(
+            f"{root} must hold one world.<mesh> and one labels.json/.yaml; found "
+            f"{[p.name for p in meshes + labels] or 'neither'}"
+        )
+    return meshes[0], labels[0]
 
 
 def user_site(
