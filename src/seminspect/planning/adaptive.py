@@ -60,8 +60,19 @@ class PredictedPath:
     guided: NDArray[np.bool_]
 
 
-def _surface_band(surface: NDArray[np.float64], height: float, half: float) -> NDArray:
-    return surface[np.abs(surface[:, 2] - height) <= half]
+def _local_frame(
+    position: NDArray[np.float64], points: NDArray[np.float64], half: float
+) -> tuple[NDArray[np.float64], float, tuple[NDArray[np.float64], ...]] | None:
+    """``p_nn``, its distance and the frame ``ν_x, ν_y, ν_z`` at ``position``, from the points
+    within ``half`` of its height; None when there are none (or the robot is on the surface)."""
+    band = points[np.abs(points[:, 2] - position[2]) <= half]
+    if not len(band):
+        return None
+    nearest, distance = nearest_surface_point(position, band)
+    try:
+        return nearest, distance, viewing_frame(position, nearest)
+    except PlanningError:
+        return None
 
 
 def predict_local_path(
@@ -101,23 +112,15 @@ def _guided_step(
     half: float,
 ) -> tuple[NDArray[np.float64], float] | None:
     """One evaluation of eqs (1)-(2); None when no surface point is in reach."""
-    band = _surface_band(points, here[2], half)
-    if not len(band):
+    start = _local_frame(here, points, half)
+    if start is None:
         return None
-    nearest, _ = nearest_surface_point(here, band)
-    try:
-        _, nu_y, nu_z = viewing_frame(here, nearest)
-    except PlanningError:
-        return None
+    _, nu_y, nu_z = start[2]
     along = here + nu_y * float(step @ nu_y) + nu_z * float(step @ nu_z)
-    band = _surface_band(points, along[2], half)
-    if not len(band):
+    stepped = _local_frame(along, points, half)
+    if stepped is None:
         return None
-    nearest, distance = nearest_surface_point(along, band)
-    try:
-        nu_x, _, _ = viewing_frame(along, nearest)
-    except PlanningError:
-        return None
+    nearest, distance, (nu_x, _, _) = stepped
     target = along + nu_x * (distance - constraints.d_view)  # eq (1)
     facing = nearest - target
     return target, math.atan2(facing[1], facing[0])  # eq (2)
