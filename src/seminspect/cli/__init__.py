@@ -33,6 +33,7 @@ GROUPS: tuple[tuple[str, str, str], ...] = (
     ("mission", "mission", "Run an xFLIE inspection mission on a simulated site (paper 000)."),
     ("graph", "graph", "Inspect, query and export 3D Layered Semantic Graphs."),
     ("terrain", "terrain", "Terrain-aware, task-driven outdoor scene graphs (paper 001)."),
+    ("routine", "routine", "Routine inspection on an outdated map: adaptive planning (paper 002)."),
     ("world", "world", "List, draw and export the built-in simulated worlds."),
     ("bench", "bench", "Studies that reproduce the papers' comparisons (planning: 000 Table 5)."),
 )

@@ -14,7 +14,7 @@ zero at their borders, so walls, roof and face meet without gaps.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.rng import make_rng
 from seminspect.worlds.builder import WorldBuilder
-from seminspect.worlds.shapes import pose_matrix, sphere
+from seminspect.worlds.shapes import Piece, pose_matrix, sphere
 from seminspect.worlds.vehicles import vehicle_pieces
 from seminspect.worlds.world import World
 
@@ -130,37 +130,58 @@ def generate_mine_drift(
     obstacle: bool = True,
 ) -> World:
     """The drift as first mapped (``historical``) or after mining (``current``)."""
-    if not (10.0 <= length <= 200.0):
-        raise InvalidInputError(f"mine drift length must be 10-200 m, got {length}")
     if not (0.0 <= recession <= 3.0):
         raise InvalidInputError(f"face recession must be 0-3 m, got {recession}")
+    current = scenario == "current"
+    rocks = []
+    if current and obstacle:
+        rocks.append(sphere(0.7, "rock").transformed(pose_matrix((0.7 * length, 1.3, 0.5))))
+    return drift_world(seed, length, recession=recession, cut_face=current, rocks=rocks)
+
+
+def drift_world(
+    seed: int,
+    length: float,
+    *,
+    recession: float = 0.0,
+    cut_face: bool = True,
+    face_advance: float = 0.0,
+    rocks: Sequence[Piece] = (),
+) -> World:
+    """The drift of ``seed`` (the same rock for every variant) with its face cut back by a
+    bowl up to ``recession`` deep (when ``cut_face``; the bounds leave room for it either way),
+    moved ``face_advance`` metres towards the portal, and
+    ``rocks`` (each a separate ``rock`` object) added: the variants routine inspection meets."""
+    if not (10.0 <= length <= 200.0):
+        raise InvalidInputError(f"mine drift length must be 10-200 m, got {length}")
+    if not (0.0 <= face_advance <= 0.5 * length):
+        raise InvalidInputError(f"face advance must be 0-{0.5 * length:g} m, got {face_advance}")
     rng = make_rng(seed, "worlds", "mine-drift", "rock")
     builder = WorldBuilder("mine-drift", seed)
     _tunnel(builder, rng, (length, DRIFT_WIDTH, DRIFT_HEIGHT), amplitude=0.12)
-    current = scenario == "current"
 
     def mined(u: NDArray, v: NDArray) -> NDArray:
         # A bowl cut into the middle of the face, deepest at its centre.
         return recession * np.exp(-((u - DRIFT_WIDTH / 2) ** 2 + (v - 2.0) ** 2) / (2 * 0.9**2))
 
+    face_x = length - face_advance
     points, faces = rock_surface(
-        (length, 0.0, 0.0),
+        (face_x, 0.0, 0.0),
         (0.0, DRIFT_WIDTH, 0.0),
         (0.0, 0.0, DRIFT_HEIGHT),
         (-1.0, 0.0, 0.0),
         relief=_relief(rng, 0.25),
-        extra=mined if current else None,
+        extra=mined if cut_face and recession > 0 else None,
     )
     face = builder.new_instance("rock-face")
     builder.add_faces(points, faces, "rock-face", "face", face)
-    if current and obstacle:
-        boulder = sphere(0.7, "rock").transformed(pose_matrix((0.7 * length, 1.3, 0.5)))
-        builder.add_object([boulder], "rock")
+    for rock in rocks:
+        builder.add_object([rock], "rock")
     return builder.build(
         bounds=[(0.0, 0.0, 0.0), (length + recession + 1.0, DRIFT_WIDTH, DRIFT_HEIGHT)],
         start_position=(2.0, DRIFT_WIDTH / 2, 0.0),
         start_yaw=0.0,
-        metadata={"ground_z": 0.0, "face_x": length, "recession": recession if current else 0.0},
+        metadata={"ground_z": 0.0, "face_x": face_x, "recession": recession if cut_face else 0.0},
     )
 
 

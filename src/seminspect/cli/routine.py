@@ -1,0 +1,157 @@
+"""``seminspect routine``: routine inspection on an outdated map (paper 002)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from seminspect.cli._common import console, err_console
+
+app = typer.Typer(no_args_is_help=True, help="Routine inspection on an outdated map (002).")
+
+_WORLD = typer.Option("mine-drift", "--world", "-w", help="Site (mine-drift).")
+_SCENARIO = typer.Option(
+    "nominal", "--scenario", "-s", help="nominal, receding, advancing or obstructed."
+)
+_SEED = typer.Option(0, "--seed", help="Seed of the site and the tour.", min=0)
+_LENGTH = typer.Option(20.0, "--length", help="Drift length [m].", min=10, max=200)
+_HISTORICAL = typer.Option(
+    None,
+    "--historical",
+    help="Your own site as first mapped: a directory with world.<mesh> and labels.json "
+    "(as 'seminspect world export' writes); replaces --world/--scenario.",
+)
+_CURRENT = typer.Option(
+    None, "--current", help="Your own site as it is now (same layout as --historical)."
+)
+
+
+def _config_and_site(world, scenario, seed, length, historical, current, *, need_current=True):
+    """The settings, and the user's site pair when --historical/--current are given."""
+    from seminspect.core.errors import InvalidInputError
+    from seminspect.missions.routine import RoutineConfig
+    from seminspect.worlds.routine_sites import user_site, world_files
+
+    if historical is None and current is None:
+        return RoutineConfig(world=world, scenario=scenario, seed=seed, length=length), None
+    if historical is None or (need_current and current is None):
+        raise InvalidInputError("--historical and --current go together")
+    before = world_files(historical)
+    site = user_site(before, world_files(current) if current is not None else before)
+    return RoutineConfig(world="user", scenario="user", seed=seed, length=length), site
+
+
+def _progress_bar():
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    return Progress(
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        TimeElapsedColumn(),
+        console=err_console,
+        transient=True,
+    )
+
+
+@app.command("map")
+def map_command(
+    world: str = _WORLD,
+    scenario: str = _SCENARIO,
+    seed: int = _SEED,
+    length: float = _LENGTH,
+    historical: Path | None = _HISTORICAL,
+    out: Path = typer.Option(..., "--out", "-o", help="Directory for the map (map.npz)."),
+) -> None:
+    """Record M_H: a mapping traverse through the scenario's historical world."""
+    from seminspect.missions.routine_run import map_site
+
+    config, site = _config_and_site(
+        world, scenario, seed, length, historical, None, need_current=False
+    )
+    with _progress_bar() as bar:
+        task = bar.add_task("mapping M_H", total=1.0)
+        path = map_site(config, out, lambda share: bar.update(task, completed=share), site)
+    console.print(f"M_H recorded: {path}")
+    console.print(f"inspect with: seminspect routine inspect --scenario {scenario} --prior {path}")
+
+
+@app.command("inspect")
+def inspect_command(
+    world: str = _WORLD,
+    scenario: str = _SCENARIO,
+    seed: int = _SEED,
+    length: float = _LENGTH,
+    historical: Path | None = _HISTORICAL,
+    current: Path | None = _CURRENT,
+    prior: Path | None = typer.Option(
+        None, "--prior", help="M_H (.npz, .bt, .ply, .pcd); default: record it first."
+    ),
+    tasks: Path | None = typer.Option(
+        None, "--tasks", help="YAML/JSON task file of regions; default: the scenario's."
+    ),
+    adapt: bool = typer.Option(
+        True, "--adapt/--no-adapt", help="Algorithm 1, or track the global tour directly."
+    ),
+    compare: bool = typer.Option(
+        False, "--compare", help="Run adaptive and non-adaptive into OUT/adaptive, OUT/baseline."
+    ),
+    out: Path = typer.Option(..., "--out", "-o", help="Run directory."),
+    pictures: bool = typer.Option(True, "--pictures/--no-pictures", help="Draw the pictures."),
+) -> None:
+    """Inspect the scenario's regions in the current world with a plan made on M_H."""
+    from seminspect.missions.routine_run import PRIOR_FILE, run_routine
+    from seminspect.report.figures import save_figure
+    from seminspect.report.routine import comparison_figure, render_routine
+
+    base, site = _config_and_site(world, scenario, seed, length, historical, current)
+    runs = {"adaptive": True, "baseline": False} if compare else {"": adapt}
+    results = {}
+    shared_prior = prior
+    with _progress_bar() as bar:
+        for name, adaptive in runs.items():
+            task = bar.add_task(name or "inspection", total=1.0)
+
+            def show(label: str, share: float, task=task, name=name) -> None:
+                bar.update(task, completed=share, description=f"{name} {label}".strip())
+
+            config = base.model_copy(update={"adapt": adaptive})
+            run_dir = out / name if name else out
+            result = run_routine(
+                config, run_dir, prior_path=shared_prior, tasks_path=tasks, progress=show, site=site
+            )
+            results[name] = result
+            if shared_prior is None and (run_dir / PRIOR_FILE).exists():
+                shared_prior = run_dir / PRIOR_FILE  # the baseline plans on the same M_H
+            if result.state != "completed":
+                break
+    if pictures:
+        for result in results.values():
+            render_routine(result.run_dir)
+        if compare and len(results) == len(runs):
+            figure = comparison_figure({n: r.run_dir for n, r in results.items()})
+            save_figure(figure, out / "comparison.png")
+    for name, result in results.items():
+        _print_result(name, result)
+    if any(r.state == "interrupted" for r in results.values()):
+        err_console.print(f"interrupted; partial results in {out}", highlight=False)
+        raise typer.Exit(130)
+
+
+def _print_result(name: str, result) -> None:
+    m = result.metrics
+    label = f"{name}: " if name else ""
+    console.print(f"[bold]{label}{result.state}[/]: {result.reason}")
+    if not m:
+        return
+    console.print(
+        f"  tasks {m['tasks_completed']}/{m['tasks_total']}, utility "
+        f"{_num(m['viewpoint_utility_mean'])}, viewing-distance MAE "
+        f"{_num(m['view_distance_mae_m'])} m, ROI coverage {_num(m['roi_coverage_pct'], 1)} %, "
+        f"max Γ_s {_num(m['gamma_s_max'])}, collisions {m['collisions']}"
+    )
+    console.print(f"  results: {result.run_dir} (summary.md, metrics.json, *.png)")
+
+
+def _num(value: float | None, digits: int = 2) -> str:
+    return "-" if value is None else f"{value:.{digits}f}"
