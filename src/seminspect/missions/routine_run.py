@@ -26,7 +26,8 @@ from typing import Any
 
 import numpy as np
 
-from seminspect.core.errors import InvalidInputError, SeminspectError
+from seminspect.core.errors import InvalidInputError
+from seminspect.core.interrupts import stop_on_signals
 from seminspect.core.io import atomic_write_text, write_versioned_json
 from seminspect.mapping.voxel import VoxelMap, save_map
 from seminspect.missions.routine import (
@@ -38,11 +39,16 @@ from seminspect.missions.routine import (
 )
 from seminspect.missions.routine_measures import region_change
 from seminspect.missions.routine_tasks import default_tasks, load_tasks
-from seminspect.missions.rundir import RunDirectory
+from seminspect.missions.rundir import ROUTINE_FILES, RunDirectory, RunEnd, conduct_run
+from seminspect.planning.global_views import InspectionRegion
 from seminspect.worlds.routine_sites import SitePair, mine_drift_site
 
 TOUR_FORMAT = "seminspect.routine-tour"
 PRIOR_FILE = "prior/map.npz"
+#: The files a finished routine run holds (metrics last, as in a mission).
+ROUTINE_OUTPUTS = (
+    "map.npz", *ROUTINE_FILES, "trajectory.csv", "events.jsonl", "summary.md", "metrics.json",
+)  # fmt: skip
 
 
 @dataclass
@@ -73,22 +79,18 @@ def map_site(
     """``routine map``: record ``M_H`` of the historical world (the scenario's, or ``site``'s)
     into ``out/map.npz``."""
     site = site if site is not None else routine_site(config)
-    run = RunDirectory(out)
-    run.write_config({"routine_map": config.model_dump(mode="json")})
-    run.write_status("running")
-    try:
-        prior = record_prior(site.historical, config, progress)
-    except KeyboardInterrupt:
-        run.write_status("interrupted", "interrupted by the operator (Ctrl-C)")
-        raise
-    path = run.write_map(prior)
-    counts = prior.counts()
-    run.write_summary(
-        f"# M_H of {config.world} {config.scenario}, seed {config.seed}\n\n"
-        f"{counts['occupied']} occupied, {counts['free']} free, {counts['unknown']} unknown "
-        f"cells of {prior.resolution:g} m.\n"
-    )
-    run.write_status("completed", "historical map recorded", map=str(path))
+    with stop_on_signals():
+        run = RunDirectory(out)
+        with run.claimed({"routine_map": config.model_dump(mode="json")}):
+            prior = record_prior(site.historical, config, progress)
+            path = run.write_map(prior)
+            counts = prior.counts()
+            run.write_summary(
+                f"# M_H of {config.world} {config.scenario}, seed {config.seed}\n\n"
+                f"{counts['occupied']} occupied, {counts['free']} free, {counts['unknown']} "
+                f"unknown cells of {prior.resolution:g} m.\n"
+            )
+            run.finish("completed", "historical map recorded")
     return path
 
 
@@ -104,44 +106,51 @@ def run_routine(
     """``routine inspect``: record or load ``M_H``, run Algorithm 1, write the run directory.
 
     ``site`` replaces the config's built-in site (a user pair, ``routine_sites.user_site``).
+    The directory is claimed as a mission's is (a lock, the code that ran, a heartbeat), and
+    Ctrl-C or SIGTERM still leave every output gathered so far with a truthful status.
     """
     site = site if site is not None else routine_site(config)
     regions = load_tasks(tasks_path) if tasks_path is not None else default_tasks(site)
-    run = RunDirectory(out)
     settings = {
         **config.model_dump(mode="json"),
         "prior": None if prior_path is None else str(prior_path),
         "tasks": None if tasks_path is None else str(tasks_path),
     }
-    run.write_config(settings)
-    run.write_status("running")
+    with stop_on_signals():
+        run = RunDirectory(out)
+        with run.claimed(settings):
+            return _run_routine(
+                run, config, site, regions, prior_path=prior_path, progress=progress
+            )
+
+
+def _run_routine(
+    run: RunDirectory,
+    config: RoutineConfig,
+    site: SitePair,
+    regions: list[InspectionRegion],
+    *,
+    prior_path: str | os.PathLike[str] | None,
+    progress: Callable[[str, float], None] | None,
+) -> RoutineResult:
     started = time.perf_counter()
-    state, reason, error = "completed", "", None
-    mission: RoutineMission | None = None
-    try:
-        prior = _prior(config, site, run, prior_path, progress)
-        mission = RoutineMission(config, site, prior, regions, progress)
-        reason = mission.execute()
-    except KeyboardInterrupt:
-        state, reason = "interrupted", "interrupted by the operator (Ctrl-C)"
-    except Exception as exc:  # recorded, then re-raised once the run directory is complete
-        state, reason, error = "failed", f"{type(exc).__name__}: {exc}", exc
+    missions: list[RoutineMission] = []
     metrics: dict[str, Any] = {}
-    try:
-        if mission is not None:
-            metrics = routine_metrics(mission, site, state, reason, time.perf_counter() - started)
-            _write_outputs(run, mission, metrics)
-    except Exception as exc:
-        failure = f"finishing the run failed: {type(exc).__name__}: {exc}"
-        state, reason = "failed", f"{reason}; {failure}" if reason else failure
-        error = error or exc
-    finally:
-        run.write_status(state, reason, run_dir=str(run.root))
-    if error is not None:
-        if isinstance(error, SeminspectError):
-            raise error
-        raise SeminspectError(f"routine run failed ({reason}); partial results in {run.root}")
-    return RoutineResult(run.root, state, reason, metrics)
+
+    def work() -> str:
+        prior = _prior(config, site, run, prior_path, progress)
+        missions.append(RoutineMission(config, site, prior, regions, progress))
+        return missions[0].execute()
+
+    def write_outputs(end: RunEnd) -> None:
+        nonlocal metrics
+        if missions:
+            wall_s = time.perf_counter() - started
+            metrics = routine_metrics(missions[0], site, end.state, end.reason, wall_s)
+            _write_outputs(run, missions[0], metrics)
+
+    end = conduct_run(run, work, write_outputs, expected=ROUTINE_OUTPUTS, what="routine run")
+    return RoutineResult(run.root, end.state, end.reason, metrics)
 
 
 def _prior(
@@ -215,7 +224,6 @@ def routine_metrics(
 
 def _write_outputs(run: RunDirectory, mission: RoutineMission, metrics: dict[str, Any]) -> None:
     run.write_map(mission.current_map)
-    run.write_metrics(metrics)
     tours = [
         {
             "task": plan.region.name,
@@ -252,6 +260,7 @@ def _write_outputs(run: RunDirectory, mission: RoutineMission, metrics: dict[str
         )
     run.flush_events()
     run.write_summary(summary_markdown(metrics))
+    run.write_metrics(metrics)  # last: a reader takes metrics.json as the run's end
 
 
 def _cell(value: Any) -> str:

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from seminspect.core.errors import SeminspectError
-from seminspect.core.interrupts import as_interrupted, deferred_signals, stop_on_signals
+from seminspect.core.interrupts import stop_on_signals
 from seminspect.mapping.voxel import VoxelMap
 from seminspect.missions.config import MissionConfig, inspection_params, resolve
 from seminspect.missions.evaluation import (
@@ -32,7 +32,7 @@ from seminspect.missions.evaluation import (
 from seminspect.missions.metrics import CpuMeter
 from seminspect.missions.platform import SimulatedPlatform, mission_noise
 from seminspect.missions.report import summary_markdown
-from seminspect.missions.rundir import OUTPUT_FILES, RunDirectory
+from seminspect.missions.rundir import OUTPUT_FILES, RunDirectory, RunEnd, conduct_run
 from seminspect.missions.xflie import MissionProgress, XFlie
 from seminspect.worlds import World, open_world
 from seminspect.worlds.catalog import is_world_path
@@ -140,49 +140,24 @@ def _run(
 ) -> MissionResult:
     mission, world = build_mission(config, run, progress, world)
     cpu = CpuMeter()
-    state, reason, error, stop = "completed", "", None, None
-    try:
-        reason = mission.execute()
-    except KeyboardInterrupt as exc:
-        stop = as_interrupted(exc)
-        state, reason = "interrupted", stop.describe()
-    except Exception as exc:  # recorded, then re-raised once the run directory is complete
-        state, reason, error = "failed", f"{type(exc).__name__}: {exc}", exc
     answers: list[QueryAnswer] = []
     metrics: dict[str, Any] = {}
-    try:
+
+    def write_outputs(end: RunEnd) -> None:
+        nonlocal answers, metrics
         if mission.graph.inspecting is not None:
             mission.graph.abort_inspection()
         run.write_graph(mission.graph)  # first: the graph survives whatever fails below
-        answers = answer_queries(mission, queries) if state == "completed" else []
-        metrics = mission_metrics(mission, world, cpu, state=state, reason=reason, answers=answers)
+        answers = answer_queries(mission, queries) if end.state == "completed" else []
+        metrics = mission_metrics(
+            mission, world, cpu, state=end.state, reason=end.reason, answers=answers
+        )
         _write_outputs(run, mission, metrics, answers)
-    except KeyboardInterrupt as exc:
-        stop = stop or as_interrupted(exc)
-        state, reason = "interrupted", _cut_short(run, reason, stop.describe())
-    except Exception as exc:
-        failure = f"finishing the run failed: {type(exc).__name__}: {exc}"
-        state, reason = "failed", _cut_short(run, reason, failure)
-        error = error or exc
-    with deferred_signals():  # a second signal must not cut the last status short
-        run.finish(state, reason)
-    if error is not None:
-        if isinstance(error, SeminspectError):
-            raise error
-        raise SeminspectError(
-            f"mission failed ({reason}); partial results in {run.root}"
-        ) from error
-    signum = stop.signum if stop else None
-    return MissionResult(run.root, state, reason, metrics, mission, world, answers, signum)
 
-
-def _cut_short(run: RunDirectory, reason: str, why: str) -> str:
-    """The reason of a run stopped while writing its outputs, naming the ones not written."""
-    missing = [name for name in OUTPUT_FILES if not run.path(name).exists()]
-    note = f"{why} while writing the outputs" + (
-        f"; not written: {', '.join(missing)}" if missing else ""
+    end = conduct_run(run, mission.execute, write_outputs, expected=OUTPUT_FILES, what="mission")
+    return MissionResult(
+        run.root, end.state, end.reason, metrics, mission, world, answers, end.signum
     )
-    return f"{reason}; {note}" if reason else note
 
 
 def answer_queries(mission: XFlie, queries: Sequence[str]) -> list[QueryAnswer]:

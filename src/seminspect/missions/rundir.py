@@ -39,8 +39,8 @@ import socket
 import threading
 import time
 import warnings
-from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
 
@@ -49,7 +49,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from seminspect.core.errors import FileFormatError, InvalidInputError, SeminspectError
-from seminspect.core.interrupts import as_interrupted
+from seminspect.core.interrupts import Interrupted, as_interrupted, deferred_signals
 from seminspect.core.io import (
     atomic_write_bytes,
     atomic_write_text,
@@ -75,10 +75,18 @@ LOCK_FILE = "run.lock"
 OUTPUT_FILES = (
     "graph.json", MAP_FILE, "trajectory.csv", "events.jsonl", "summary.md", "metrics.json",
 )  # fmt: skip
-#: Everything a run writes at the top of its directory (pictures are ``*.png``).
-RUN_FILES = frozenset({"status.json", "config.json", LOCK_FILE, *OUTPUT_FILES})
+#: What a routine run (002) writes besides the common files.
+ROUTINE_FILES = ("tour.json", "views.csv")
+#: Everything a run of any kind writes at the top of its directory (pictures are ``*.png``).
+RUN_FILES = frozenset(
+    {"status.json", "config.json", LOCK_FILE, "report.html", *OUTPUT_FILES, *ROUTINE_FILES}
+)
 #: Folders a run writes, and the pattern of the files inside them.
-RUN_FOLDERS = {"snapshots": re.compile(r"graph-[\d.]+s\.json"), "images": re.compile(r".+\.jpg")}
+RUN_FOLDERS = {
+    "snapshots": re.compile(r"graph-[\d.]+s\.json"),
+    "images": re.compile(r".+\.jpg"),
+    "prior": re.compile(r"map\.npz"),
+}
 #: A temporary file of an atomic write that was cut short: ``.<target>.<random>.<suffix>``.
 _LEFTOVER = re.compile(r"\.(?P<target>.+)\.\w+\.\w+")
 #: Seconds between heartbeats, and the age after which a silent run counts as abandoned.
@@ -239,6 +247,71 @@ class RunDirectory:
     @property
     def events(self) -> list[dict[str, Any]]:
         return list(self._events)
+
+
+@dataclass
+class RunEnd:
+    """How a run ended: its last state, why, and the error or stop signal behind it."""
+
+    state: str = "completed"
+    reason: str = ""
+    error: Exception | None = None
+    stop: Interrupted | None = field(default=None, repr=False)
+
+    @property
+    def signum(self) -> int | None:
+        """The signal that stopped the run, if one did."""
+        return self.stop.signum if self.stop else None
+
+
+def conduct_run(
+    run: RunDirectory,
+    work: Callable[[], str],
+    write_outputs: Callable[[RunEnd], None],
+    *,
+    expected: Sequence[str],
+    what: str,
+) -> RunEnd:
+    """Do ``work`` (it returns why it stopped), then ``write_outputs`` whatever happened, then
+    the last status, which is truthful: a stop while writing names the ``expected`` files that
+    were not written. A failure is re-raised once the directory is complete, as a
+    :class:`SeminspectError` naming ``what`` failed and where the partial results are."""
+    end = RunEnd()
+    try:
+        end.reason = work()
+    except KeyboardInterrupt as exc:
+        end.stop = as_interrupted(exc)
+        end.state, end.reason = "interrupted", end.stop.describe()
+    except Exception as exc:
+        end.state, end.reason, end.error = "failed", f"{type(exc).__name__}: {exc}", exc
+    try:
+        write_outputs(end)
+    except KeyboardInterrupt as exc:
+        end.stop = end.stop or as_interrupted(exc)
+        end.state = "interrupted"
+        end.reason = _cut_short(run, end.reason, end.stop.describe(), expected)
+    except Exception as exc:
+        failure = f"finishing the run failed: {type(exc).__name__}: {exc}"
+        end.state, end.reason = "failed", _cut_short(run, end.reason, failure, expected)
+        end.error = end.error or exc
+    with deferred_signals():  # a second signal must not cut the last status short
+        run.finish(end.state, end.reason)
+    if end.error is not None:
+        if isinstance(end.error, SeminspectError):
+            raise end.error
+        raise SeminspectError(
+            f"{what} failed ({end.reason}); partial results in {run.root}"
+        ) from end.error
+    return end
+
+
+def _cut_short(run: RunDirectory, reason: str, why: str, expected: Sequence[str]) -> str:
+    """The reason of a run stopped while writing its outputs, naming the ones not written."""
+    missing = [name for name in expected if not run.path(name).exists()]
+    note = f"{why} while writing the outputs" + (
+        f"; not written: {', '.join(missing)}" if missing else ""
+    )
+    return f"{reason}; {note}" if reason else note
 
 
 class _RunLock:
