@@ -14,6 +14,7 @@ def test_mission_runs_and_says_where_the_results_are(capsys, tmp_path: Path) -> 
     assert "completed" in text and str(out) in text and "query 'Visit car-0': reached" in text
     for picture in ("trajectory.png", "graph.png", "utility.png"):
         assert (out / picture).read_bytes()[:4] == b"\x89PNG"
+    assert "plotly" in (out / "report.html").read_text(encoding="utf-8")
 
 
 @pytest.mark.parametrize(

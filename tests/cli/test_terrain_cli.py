@@ -22,7 +22,7 @@ def test_graph_command_end_to_end_on_a_small_cloud(
     assert summary["objects"] == {"image of a tree": 2, "image of a car": 3}
     assert all(n > 0 for n in summary["places"].values())
     for name in ("graph.json", "graph.graphml", "layer1.npz", "classified_cloud.png",
-                 "places.png", "layers.png", "gvd_0_sidewalk.png"):  # fmt: skip
+                 "places.png", "layers.png", "gvd_0_sidewalk.png", "report.html"):  # fmt: skip
         assert (out / name).stat().st_size > 0, name
     graph = json.loads((out / "graph.json").read_text())
     places = [n["id"] for n in graph["nodes"] if n["kind"] == "place"]

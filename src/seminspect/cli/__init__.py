@@ -31,6 +31,7 @@ GROUPS: tuple[tuple[str, str, str], ...] = (
     ("terrain", "terrain", "Terrain-aware, task-driven outdoor scene graphs (paper 001)."),
     ("world", "world", "List, draw and export the built-in simulated worlds."),
     ("bench", "bench", "Studies that reproduce the papers' comparisons (planning: 000 Table 5)."),
+    ("view", "view", "Open a run's report.html (3D graph, tables, plots) in the browser."),
 )
 
 app = typer.Typer(

@@ -71,6 +71,7 @@ def app(
 
     from seminspect.missions.config import make_config
     from seminspect.missions.run import run_mission
+    from seminspect.report.html import write_mission_report
     from seminspect.report.mission import render_run
 
     config = make_config(
@@ -105,6 +106,7 @@ def app(
         result = run_mission(config, out, queries=query, progress=show)
     if pictures:
         render_run(result.run_dir)
+        write_mission_report(result.run_dir)
     _print_result(result)
     if result.state == "interrupted":
         err_console.print(f"interrupted; partial results in {result.run_dir}", highlight=False)
@@ -127,7 +129,7 @@ def _print_result(result) -> None:
     for answer in result.answers:
         outcome = "reached" if answer.reached else f"not reached ({answer.error or 'too far'})"
         console.print(f"query '{answer.query}': {outcome}")
-    console.print(f"results: {result.run_dir}  (summary.md, graph.json, metrics.json, *.png)")
+    console.print(f"results: {result.run_dir}  (report.html, summary.md, graph.json, *.png)")
     console.print(
         f"query the graph: seminspect graph query {result.run_dir / 'graph.json'} 'Visit ...'"
     )

@@ -194,6 +194,7 @@ def graph(
     from seminspect.graphs.terrain.prompting import TaskPrompts
     from seminspect.graphs.terrain.scene_graph import build_terrain_graph
     from seminspect.perception.encoders import calibration_for
+    from seminspect.report.html import write_terrain_report
 
     prompts = TaskPrompts.parse(terrain, objects)
     params = make_terrain_params(_param_overrides(param, cell_size))
@@ -230,7 +231,8 @@ def graph(
         "quality": quality,
     }
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2) + "\n")
-    console.print(f"[bold]terrain graph[/] written to {out}")
+    write_terrain_report(out)
+    console.print(f"[bold]terrain graph[/] written to {out} (open report.html in a browser)")
     console.print_json(json.dumps({k: v for k, v in summary.items() if k != "seconds"}))
 
 
