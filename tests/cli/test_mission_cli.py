@@ -29,3 +29,12 @@ def test_bad_mission_settings_exit_non_zero_with_one_line(capsys, tmp_path, args
     code, _, err = run(capsys, *args, "--out", str(tmp_path / "run"))
     assert code != 0 and message in err and "Traceback" not in err
     assert err.strip().count("\n") == 0  # one line
+
+
+def test_an_existing_bag_is_refused_before_the_mission(capsys, tmp_path) -> None:
+    (tmp_path / "taken").mkdir()
+    code, _, err = run(
+        capsys, "mission", "--bag", str(tmp_path / "taken"), "--out", str(tmp_path / "run")
+    )
+    assert code == 1 and "exists; choose a new bag name" in err
+    assert not (tmp_path / "run").exists()

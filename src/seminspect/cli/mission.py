@@ -62,6 +62,9 @@ def app(
     pictures: bool = typer.Option(
         True, "--pictures/--no-pictures", help="Draw the run's pictures."
     ),
+    bag: Path | None = typer.Option(
+        None, "--bag", help="Replay the run's LiDAR stream into this new ROS2 bag (directory)."
+    ),
 ) -> None:
     """Explore a site, inspect every target level by level and build its 3DLSG (paper 000).
 
@@ -69,11 +72,14 @@ def app(
     """
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
+    from seminspect.core.errors import InvalidInputError
     from seminspect.missions.config import make_config
     from seminspect.missions.run import run_mission
     from seminspect.report.html import write_mission_report
     from seminspect.report.mission import render_run
 
+    if bag is not None and bag.exists():  # refuse before the mission, not after it
+        raise InvalidInputError(f"{bag} exists; choose a new bag name")
     config = make_config(
         {
             "world": world, "scenario": scenario, "seed": seed, "preset": preset,
@@ -107,10 +113,26 @@ def app(
     if pictures:
         render_run(result.run_dir)
         write_mission_report(result.run_dir)
+    if bag is not None:
+        _export_bag(result.run_dir, bag)
     _print_result(result)
     if result.state == "interrupted":
         err_console.print(f"interrupted; partial results in {result.run_dir}", highlight=False)
         raise typer.Exit(130)
+
+
+def _export_bag(run_dir: Path, bag: Path) -> None:
+    from rich.progress import MofNCompleteColumn, Progress
+
+    from seminspect.missions.replay import export_run_bag
+
+    columns = (*Progress.get_default_columns()[:2], MofNCompleteColumn())
+    with Progress(*columns, console=err_console, transient=True) as progress:
+        task = progress.add_task("replaying LiDAR into the bag", total=None)
+        export_run_bag(
+            run_dir, bag, on_scan=lambda d, n: progress.update(task, completed=d, total=n)
+        )
+    console.print(f"ROS2 bag: {bag} (/points PointCloud2 with labels, /odom Odometry)")
 
 
 def _print_result(result) -> None:
