@@ -31,6 +31,7 @@ GROUPS: tuple[tuple[str, str, str], ...] = (
     ("terrain", "terrain", "Terrain-aware, task-driven outdoor scene graphs (paper 001)."),
     ("world", "world", "List, draw and export the built-in simulated worlds."),
     ("bench", "bench", "Studies that reproduce the papers' comparisons (planning: 000 Table 5)."),
+    ("sweep", "sweep", "Many missions (worlds x scenarios x seeds x settings) on Ray, one table."),
     ("view", "view", "Open a run's report.html (3D graph, tables, plots) in the browser."),
 )
 
@@ -82,7 +83,10 @@ def main(argv: Sequence[str] | None = None) -> None:
     args = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in args or os.environ.get("SEMINSPECT_DEBUG") == "1"
     try:
-        app(args=args, prog_name="seminspect", standalone_mode=False)
+        # outside standalone mode click returns a command's typer.Exit code instead of raising
+        code = app(args=args, prog_name="seminspect", standalone_mode=False)
+        if isinstance(code, int) and code:
+            raise SystemExit(code)
     except typer.Exit as done:
         raise SystemExit(done.exit_code) from None
     except _USAGE_ERROR as exc:
