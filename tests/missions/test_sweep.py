@@ -20,7 +20,7 @@ from seminspect.missions.sweep import (
 )
 
 
-def test_the_grid_expands_into_one_validated_task_per_mission(tmp_path) -> None:
+def test_the_grid_expands_into_one_validated_task_per_mission(tmp_path, monkeypatch) -> None:
     spec = SweepSpec(
         worlds=["city", "campus"], scenarios=["small"], seeds=[0, 1],
         settings={"planner": ["hierarchical", "volumetric"]},
@@ -32,6 +32,8 @@ def test_the_grid_expands_into_one_validated_task_per_mission(tmp_path) -> None:
     assert first.group == "city small planner=hierarchical"
     assert first.config["time_budget_s"] is not None  # resolved, as reusable_run compares it
     assert {t.run_dir for t in tasks} == {str(tmp_path / t.name) for t in tasks}
+    monkeypatch.chdir(tmp_path)  # Ray workers may run elsewhere: run directories are absolute
+    assert expand(spec, "rel")[0].run_dir == str(tmp_path.resolve() / "rel" / first.name)
     with pytest.raises(InvalidInputError, match="planner"):
         expand(SweepSpec(worlds=["city"], settings={"planner": ["teleport"]}), tmp_path)
     with pytest.raises(InvalidInputError, match="repeats a mission"):

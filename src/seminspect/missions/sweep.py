@@ -85,7 +85,11 @@ def _slug(value: Any) -> str:
 
 
 def expand(spec: SweepSpec, out_dir: str | os.PathLike[str]) -> list[SweepTask]:
-    """Every task of the grid, each configuration validated (bad settings fail here, once)."""
+    """Every task of the grid, each configuration validated (bad settings fail here, once).
+
+    Run directories are absolute: Ray workers need not share the caller's working directory.
+    """
+    root = Path(out_dir).resolve()
     keys = sorted(spec.settings)
     for key in keys:
         if not spec.settings[key]:
@@ -103,9 +107,7 @@ def expand(spec: SweepSpec, out_dir: str | os.PathLike[str]) -> list[SweepTask]:
             name = run_name(config) + varied
             group = f"{config.world} {config.scenario or ''}".strip()
             group += "".join(f" {k}={v}" for k, v in chosen.items())
-            tasks.append(
-                SweepTask(name, group, config.model_dump(mode="json"), str(Path(out_dir) / name))
-            )
+            tasks.append(SweepTask(name, group, config.model_dump(mode="json"), str(root / name)))
     names = [t.name for t in tasks]
     if len(set(names)) != len(names):
         raise InvalidInputError("the grid repeats a mission (a world, scenario or seed twice)")
