@@ -127,6 +127,18 @@ def test_terrain_report_has_layers_two_to_five(terrain_report: Path) -> None:
     assert layers["Points"] > 0 and expected["Objects"] == 5
 
 
+def test_an_interrupted_run_without_metrics_or_path_still_gets_a_page(
+    small_mission_dir: Path, tmp_path: Path
+) -> None:
+    run_dir = tmp_path / "stopped"
+    shutil.copytree(small_mission_dir, run_dir, ignore=shutil.ignore_patterns("*.html"))
+    for name in ("metrics.json", "trajectory.csv", "events.jsonl"):
+        (run_dir / name).unlink()
+    page = write_report(run_dir).read_text(encoding="utf-8")
+    assert "wrote no metrics" in page
+    assert _figure_layers(page) == _expected_mission_layers(small_mission_dir)
+
+
 def test_a_directory_without_a_graph_is_refused(tmp_path: Path) -> None:
     with pytest.raises(InvalidInputError, match=r"no graph\.json"):
         write_report(tmp_path)
