@@ -1,8 +1,9 @@
 """``seminspect view``: open a run's report in the browser, served from localhost.
 
-viser (spark-dsg's live viewer) needs rich < 15, which conflicts with seminspect's own
-dependencies, so the viewer is the run's ``report.html`` (plotly, turnable and queryable in 3D)
-served by the standard library's HTTP server on 127.0.0.1 only.
+viser (spark-dsg's live viewer; 1.1.1 when this was written) needs rich < 15, which conflicts
+with the rich 15 seminspect's environment carries, so the viewer is the run's ``report.html``
+(plotly, turnable and queryable in 3D) served by the standard library's HTTP server on
+127.0.0.1 only.
 """
 
 from __future__ import annotations
