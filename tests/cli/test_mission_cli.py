@@ -14,6 +14,7 @@ def test_mission_runs_and_says_where_the_results_are(capsys, tmp_path: Path) -> 
     assert "completed" in text and str(out) in text and "query 'Visit car-0': reached" in text
     for picture in ("trajectory.png", "graph.png", "utility.png"):
         assert (out / picture).read_bytes()[:4] == b"\x89PNG"
+    assert "plotly" in (out / "report.html").read_text(encoding="utf-8")
 
 
 @pytest.mark.parametrize(
@@ -43,3 +44,12 @@ def test_resume_refuses_mixed_settings_and_finished_runs(capsys, tmp_path: Path)
     assert code == 1 and "completed run; nothing to resume" in err
     code, _, err = run(capsys, "mission", "--resume", str(tmp_path))
     assert code == 1 and "not a run directory" in err
+
+
+def test_an_existing_bag_is_refused_before_the_mission(capsys, tmp_path) -> None:
+    (tmp_path / "taken").mkdir()
+    code, _, err = run(
+        capsys, "mission", "--bag", str(tmp_path / "taken"), "--out", str(tmp_path / "run")
+    )
+    assert code == 1 and "exists; choose a new bag name" in err
+    assert not (tmp_path / "run").exists()

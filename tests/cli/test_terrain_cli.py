@@ -1,6 +1,7 @@
 import json
 
 import numpy as np
+import pytest
 
 from cli_runner import run
 
@@ -22,7 +23,7 @@ def test_graph_command_end_to_end_on_a_small_cloud(
     assert summary["objects"] == {"image of a tree": 2, "image of a car": 3}
     assert all(n > 0 for n in summary["places"].values())
     for name in ("graph.json", "graph.graphml", "layer1.npz", "classified_cloud.png",
-                 "places.png", "layers.png", "gvd_0_sidewalk.png"):  # fmt: skip
+                 "places.png", "layers.png", "gvd_0_sidewalk.png", "report.html"):  # fmt: skip
         assert (out / name).stat().st_size > 0, name
     graph = json.loads((out / "graph.json").read_text())
     places = [n["id"] for n in graph["nodes"] if n["kind"] == "place"]
@@ -77,3 +78,36 @@ def test_errors_are_one_line_and_exit_non_zero(
     ):  # fmt: skip
         code, _, err = run(capsys, *argv)
         assert code == 1 and err.startswith("error:") and "\n" not in err.strip(), err
+
+
+def test_a_bag_becomes_a_cloud_and_then_a_graph(capsys, tmp_path, labelled_scene, fake_encoder):
+    pytest.importorskip("rosbags", reason="the 'ros' extra (rosbags) is not installed")
+    from seminspect.mapping.rosbag import BagScan, BagTopics, write_bag
+    from seminspect.mapping.semantic_cloud import load_cloud
+
+    points, labels, names = labelled_scene
+    halves = [slice(0, len(points) // 2), slice(len(points) // 2, None)]
+    scans = [BagScan(k * 10**8, points[h], labels[h], np.eye(4)) for k, h in enumerate(halves)]
+    bag = write_bag(tmp_path / "drive", scans, names, BagTopics(cloud="/velodyne"))
+    cloud = tmp_path / "cloud.npz"
+    code, out_text, err = run(
+        capsys, "terrain", "map", "--bag", str(bag), "--cloud-topic", "/velodyne",
+        "--encoder", "hashing-test", "--noise", "0", "--out", str(cloud),
+    )  # fmt: skip
+    assert code == 0, err
+    fused = load_cloud(cloud)
+    assert f"{len(fused):,} points" in out_text and 0.99 * len(points) < len(fused) <= len(points)
+    assert fused.source == {"bag": str(bag), "cloud_topic": "/velodyne", "odom_topic": "/odom"}
+    out = tmp_path / "graph"
+    code, _, err = run(
+        capsys, "terrain", "graph", str(cloud), "--encoder", "hashing-test", "--terrain",
+        "sidewalk,grass,road", "--param", "split_length=6.0", "--out", str(out),
+    )  # fmt: skip
+    assert code == 0, err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["objects"] == {"image of a tree": 2, "image of a car": 3}
+    code, _, err = run(
+        capsys, "terrain", "map", "--bag", str(bag), "--encoder", "hashing-test", "--out",
+        str(tmp_path / "other.npz"),
+    )  # fmt: skip
+    assert code == 1 and "no topic '/points'" in err and len(err.strip().splitlines()) == 1

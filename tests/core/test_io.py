@@ -12,6 +12,7 @@ from seminspect.core.io import (
     atomic_write_text,
     read_json,
     read_versioned_json,
+    read_yaml,
     save_npz_atomic,
     write_versioned_json,
 )
@@ -83,3 +84,15 @@ def test_binary_missing_directory_and_oversized_files(tmp_path: Path) -> None:
     big.write_text(json.dumps({"x": "y" * 2000}))
     with pytest.raises(FileFormatError, match="larger than"):
         read_json(big, max_bytes=1000)
+
+
+def test_read_yaml_turns_every_broken_file_into_one_line(tmp_path) -> None:
+    good = tmp_path / "grid.yaml"
+    good.write_text("worlds: [city]\nseeds: [0, 1]\n", encoding="utf-8")
+    assert read_yaml(good) == {"worlds": ["city"], "seeds": [0, 1]}
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("worlds: [city\n", encoding="utf-8")
+    with pytest.raises(FileFormatError, match="malformed YAML"):
+        read_yaml(bad)
+    with pytest.raises(FileFormatError, match="no such file"):
+        read_yaml(tmp_path / "missing.yaml")

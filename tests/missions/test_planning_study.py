@@ -10,7 +10,7 @@ from seminspect.core.errors import InvalidInputError
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.synthetic import synthetic_graph
 from seminspect.mapping.voxel import VoxelMap, save_map
-from seminspect.missions import planning_study
+from seminspect.missions import planning_study, sweep
 from seminspect.missions.planning_study import (
     MissionOutcome,
     PathCheck,
@@ -99,7 +99,7 @@ def test_only_a_complete_run_of_the_same_configuration_is_reused(tmp_path, monke
     assert not reusable_run(_fake_run(tmp_path / "other", seed=3), config)
     assert not reusable_run(tmp_path / "missing", config)
     # ensure_run reuses the complete run under its study name, without running anything
-    monkeypatch.setattr(planning_study, "run_mission", lambda *a, **k: pytest.fail("ran"))
+    monkeypatch.setattr(sweep, "run_mission", lambda *a, **k: pytest.fail("ran"))
     complete = _fake_run(tmp_path / "city-small-seed0-hierarchical")
     assert ensure_run(config, tmp_path) == complete
     stray = tmp_path / "city-small-seed0-volumetric-charged"
@@ -110,7 +110,7 @@ def test_only_a_complete_run_of_the_same_configuration_is_reused(tmp_path, monke
 
 def test_an_unfinished_study_run_is_run_again(tmp_path, monkeypatch) -> None:
     calls = []
-    monkeypatch.setattr(planning_study, "run_mission", lambda c, out, **k: calls.append(out))
+    monkeypatch.setattr(sweep, "run_mission", lambda c, out, **k: calls.append(out))
     stale = _fake_run(tmp_path / "city-small-seed0-hierarchical", "interrupted")
     (stale / "images").mkdir()
     assert ensure_run(study_config("small"), tmp_path) == stale

@@ -36,6 +36,8 @@ GROUPS: tuple[tuple[str, str, str], ...] = (
     ("routine", "routine", "Routine inspection on an outdated map: adaptive planning (paper 002)."),
     ("world", "world", "List, draw and export the built-in simulated worlds."),
     ("bench", "bench", "Studies that reproduce the papers' comparisons (planning: 000 Table 5)."),
+    ("sweep", "sweep", "Many missions (worlds x scenarios x seeds x settings) on Ray, one table."),
+    ("view", "view", "Open a run's report.html (3D graph, tables, plots) in the browser."),
 )
 
 app = typer.Typer(

@@ -74,14 +74,20 @@ def app(
         help="Finish a run that was interrupted, failed or killed: run its configuration again "
         "from the start into its directory (missions are deterministic).",
     ),
+    bag: Path | None = typer.Option(
+        None, "--bag", help="Replay the run's LiDAR stream into this new ROS2 bag (directory)."
+    ),
 ) -> None:
     """Explore a site, inspect every target level by level and build its 3DLSG (paper 000).
 
     Writes a run directory with the graph, metrics, a summary, the trajectory and pictures.
     Ctrl-C and SIGTERM stop the mission and leave a valid run directory (exit codes 130, 143).
     """
+    from seminspect.core.errors import InvalidInputError
     from seminspect.missions.config import make_config
 
+    if bag is not None and bag.exists():  # refuse before the mission, not after it
+        raise InvalidInputError(f"{bag} exists; choose a new bag name")
     if resume is not None:
         config, out = _resumed(ctx, resume)
     else:
@@ -96,9 +102,13 @@ def app(
             writable_directory(out)
     result = _run_with_progress(config, out, query)
     if pictures and result.stop_signal != signal.SIGTERM:  # SIGTERM asks to stop now
+        from seminspect.report.html import write_mission_report
         from seminspect.report.mission import render_run
 
         render_run(result.run_dir)
+        write_mission_report(result.run_dir)
+    if bag is not None and result.state == "completed":
+        _export_bag(result.run_dir, bag)
     _print_result(result)
     if result.state == "interrupted":
         err_console.print(f"interrupted; partial results in {result.run_dir}", highlight=False)
@@ -174,6 +184,20 @@ def _run_with_progress(config, out: Path | None, queries: list[str]):
         return run_mission(config, out, queries=queries, progress=show)
 
 
+def _export_bag(run_dir: Path, bag: Path) -> None:
+    from rich.progress import MofNCompleteColumn, Progress
+
+    from seminspect.missions.replay import export_run_bag
+
+    columns = (*Progress.get_default_columns()[:2], MofNCompleteColumn())
+    with Progress(*columns, console=err_console, transient=True) as progress:
+        task = progress.add_task("replaying LiDAR into the bag", total=None)
+        export_run_bag(
+            run_dir, bag, on_scan=lambda d, n: progress.update(task, completed=d, total=n)
+        )
+    console.print(f"ROS2 bag: {bag} (/points PointCloud2 with labels, /odom Odometry)")
+
+
 def _print_result(result) -> None:
     metrics = result.metrics
     t3, t6, mission = metrics["table3"], metrics["table6"], metrics["mission"]
@@ -190,7 +214,7 @@ def _print_result(result) -> None:
     for answer in result.answers:
         outcome = "reached" if answer.reached else f"not reached ({answer.error or 'too far'})"
         console.print(f"query '{answer.query}': {outcome}")
-    console.print(f"results: {result.run_dir}  (summary.md, graph.json, metrics.json, *.png)")
+    console.print(f"results: {result.run_dir}  (report.html, summary.md, graph.json, *.png)")
     console.print(
         f"query the graph: seminspect graph query {result.run_dir / 'graph.json'} 'Visit ...'"
     )

@@ -206,6 +206,7 @@ def graph(
     from seminspect.graphs.terrain.prompting import TaskPrompts
     from seminspect.graphs.terrain.scene_graph import build_terrain_graph
     from seminspect.perception.encoders import calibration_for
+    from seminspect.report.html import write_terrain_report
 
     writable_directory(out)
     _positive_radius(radius)
@@ -244,7 +245,10 @@ def graph(
         "quality": quality,
     }
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2) + "\n")
-    console.print(labelled("terrain graph", "bold", f"written to {out}"))
+    write_terrain_report(out)
+    console.print(
+        labelled("terrain graph", "bold", f"written to {out} (open report.html in a browser)")
+    )
     console.print_json(json.dumps({k: v for k, v in summary.items() if k != "seconds"}))
 
 
@@ -284,12 +288,28 @@ def map_command(
     noise: float = typer.Option(0.3, help="Caption noise per view (caption encoders)."),
     spacing: float = typer.Option(1.0, help="Metres driven between frames."),
     radius: float = typer.Option(0.15, help="Association radius of scan points to map points [m]."),
+    bag: Path | None = typer.Option(
+        None, "--bag", help="Map a ROS1/ROS2 bag's labelled clouds instead of a simulated world."
+    ),
+    cloud_topic: str = typer.Option("/points", help="PointCloud2 topic of the bag."),
+    odom_topic: str = typer.Option("/odom", help="Odometry topic of the bag (the cloud's pose)."),
+    labels_field: str = typer.Option("label", help="Integer label field of the bag's clouds."),
+    label_names: str | None = typer.Option(
+        None,
+        help="Names of the bag's labels, e.g. '0=grass,1=car' (default: the bag's own names "
+        "topic, else SemanticKITTI's table).",
+    ),
 ) -> None:
     """Phase 1 (001 Sec III-A) in the simulator: drive a world's path, fuse LiDAR and camera.
 
     Writes the metric-semantic cloud that 'seminspect terrain graph' reads; the cloud remembers
-    its world, so 'terrain graph CLOUD --evaluate' scores the graph against that world.
+    its world, so 'terrain graph CLOUD --evaluate' scores the graph against that world. With
+    --bag, the cloud is fused from a recorded bag's labelled PointCloud2 and Odometry instead.
     """
+    if bag is not None:
+        bag_topics = (cloud_topic, odom_topic, labels_field, label_names)
+        _map_bag(bag, bag_topics, out, _encoder(encoder_name, noise, seed), radius)
+        return
     from rich.progress import MofNCompleteColumn, Progress, TimeElapsedColumn
 
     from seminspect.mapping.semantic_cloud import save_cloud
@@ -321,6 +341,38 @@ def map_command(
             f"per frame: sensors {seconds['sensors']:.1f} s, segments {seconds['segments']:.1f} s, "
             f"fusion {seconds['fusion']:.1f} s)",
         ),
+        highlight=False,
+        soft_wrap=True,
+    )
+
+
+def _map_bag(bag: Path, topics: tuple[str, str, str, str | None], out: Path, encoder, radius):
+    """001's metric-semantic cloud from a bag's labelled clouds, one view per cloud."""
+    from rich.progress import Progress, TimeElapsedColumn
+
+    from seminspect.mapping.pointfiles import label_names_from_text
+    from seminspect.mapping.rosbag import fuse_bag, read_bag_scans, read_label_names
+    from seminspect.mapping.semantic_cloud import save_cloud
+    from seminspect.mapping.semantickitti import label_table
+
+    cloud_topic, odom_topic, labels_field, names_text = topics
+    names = label_names_from_text(names_text) if names_text else read_label_names(bag)
+    columns = (*Progress.get_default_columns()[:1], TimeElapsedColumn())
+    with Progress(*columns, console=console, transient=True) as progress:
+        task = progress.add_task("phase 1: fusing the bag's clouds", total=None)
+        scans = read_bag_scans(bag, cloud_topic, odom_topic, labels_field)
+        cloud = fuse_bag(
+            scans,
+            names or label_table().names,
+            encoder,
+            radius,
+            on_scan=lambda done: progress.update(task, description=f"fused {done} clouds"),
+        )
+    cloud.source = {"bag": str(bag), "cloud_topic": cloud_topic, "odom_topic": odom_topic}
+    save_cloud(out, cloud)
+    console.print(
+        f"[bold]semantic cloud[/] written to {out}: {len(cloud):,} points from {bag}, "
+        f"{cloud.counts.mean():.1f} views per point",
         highlight=False,
         soft_wrap=True,
     )

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import yaml
 
 from seminspect.core.errors import FileFormatError
 
@@ -186,3 +187,18 @@ def read_versioned_json(
 def finite_or_none(value: float) -> float | None:
     """Map NaN and infinity to ``None`` for JSON output."""
     return value if math.isfinite(value) else None
+
+
+def read_yaml(path: str | os.PathLike[str]) -> Any:
+    """Read a YAML file (safe loader); any way it can be broken is a :class:`FileFormatError`."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise FileFormatError(f"{path}: no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise FileFormatError(f"{path}: cannot read ({exc})") from None
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise FileFormatError(f"{path}: malformed YAML: {str(exc).splitlines()[0]}") from None

@@ -20,7 +20,6 @@ configuration, so the study can be repeated quickly.
 from __future__ import annotations
 
 import math
-import shutil
 import statistics
 from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass, field
@@ -36,15 +35,15 @@ from seminspect.graphs.lsg.io import load_graph
 from seminspect.graphs.lsg.model import EdgeKind, FeatureNode, TargetNode, TargetStatus
 from seminspect.mapping.voxel import VoxelMap, load_map
 from seminspect.missions.config import CITY_BUDGETS, MissionConfig, make_config, resolve
-from seminspect.missions.run import run_mission, run_name
+from seminspect.missions.run import run_name
 from seminspect.missions.rundir import (
     MAP_FILE,
     load_run_world,
     load_trajectory,
     read_run_config,
     read_run_metrics,
-    reusable_run,
 )
+from seminspect.missions.sweep import run_or_reuse
 from seminspect.missions.xflie import PLANNING_MARGIN, MissionProgress
 from seminspect.planning.comparison import (
     HierarchicalTiming,
@@ -149,13 +148,7 @@ def ensure_run(
     config = resolve(config)
     suffix = f"-{config.planner}" + ("-charged" if config.charge_planning_time else "")
     out = Path(runs_dir) / (run_name(config) + suffix)
-    if reusable_run(out, config):
-        return out
-    if out.exists():
-        if not (out / "status.json").is_file():
-            raise InvalidInputError(f"{out} exists and is not a run directory; move it away")
-        shutil.rmtree(out)  # an interrupted, failed or differently configured run of the study
-    run_mission(config, out, progress=progress)
+    run_or_reuse(config, out, progress)
     return out
 
 

@@ -39,7 +39,8 @@ def _extent(graph: LayeredSemanticGraph) -> float:
     return float(np.ptp(points, axis=0).max()) if len(points) > 1 else 10.0
 
 
-def _lifted(node: Node, heights: dict[Layer, float]) -> NDArray[np.float64]:
+def lifted_position(node: Node, heights: dict[Layer, float]) -> NDArray[np.float64]:
+    """Where a node is drawn: at its layer's height (robot above the Target layer)."""
     x, y, z = node.position
     if isinstance(node, RobotNode):
         return np.array(
@@ -61,7 +62,7 @@ def draw_layers(
     for outline in footprints:
         ring = np.vstack([outline, outline[:1]])
         axes.plot(ring[:, 0], ring[:, 1], 0.0, color="0.55", linewidth=0.8)
-    lifted = {node.id: _lifted(node, heights) for node in graph.nodes()}
+    lifted = {node.id: lifted_position(node, heights) for node in graph.nodes()}
     for edge in graph.edges():
         a, b = lifted[edge.u], lifted[edge.v]
         if edge.kind is EdgeKind.SPATIAL:
@@ -110,7 +111,7 @@ def _draw_plan(
     axes, graph: LayeredSemanticGraph, plan: RoutePlan, heights: dict[Layer, float]
 ) -> None:
     targets = [graph.node(t) for t in plan.target_route]
-    lifted = np.array([_lifted(t, heights) for t in targets])
+    lifted = np.array([lifted_position(t, heights) for t in targets])
     axes.plot(
         lifted[:, 0],
         lifted[:, 1],
@@ -119,7 +120,9 @@ def _draw_plan(
         linewidth=2.5,
         label="global route",
     )
-    local = np.array([_lifted(graph.node(n), heights) for n in plan.pose_route or plan.node_path])
+    local = np.array(
+        [lifted_position(graph.node(n), heights) for n in plan.pose_route or plan.node_path]
+    )
     if len(local):
         axes.plot(
             local[:, 0],

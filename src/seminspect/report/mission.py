@@ -67,9 +67,10 @@ def trajectory_figure(world: World, graph: LayeredSemanticGraph, trajectory: np.
     return figure
 
 
-def utility_figure(events: list[dict]):
-    figure = new_figure(10, 5)
-    ax = figure.add_subplot()
+def utility_series(
+    events: list[dict],
+) -> tuple[dict[str, list[tuple[float, float]]], list[tuple[float, float]]]:
+    """``(time, U)`` per target over every decision, and the ``(time, U)`` of each choice."""
     series: dict[str, list[tuple[float, float]]] = {}
     chosen: list[tuple[float, float]] = []
     for event in events:
@@ -79,6 +80,13 @@ def utility_figure(events: list[dict]):
             series.setdefault(target, []).append((event["t"], terms[0]))
             if target == event.get("chosen"):
                 chosen.append((event["t"], terms[0]))
+    return series, chosen
+
+
+def utility_figure(events: list[dict]):
+    figure = new_figure(10, 5)
+    ax = figure.add_subplot()
+    series, chosen = utility_series(events)
     for target, points in sorted(series.items()):
         data = np.array(points)
         ax.plot(data[:, 0], data[:, 1], marker=".", linewidth=0.8, label=target)

@@ -50,7 +50,8 @@ def _save(fig: Figure, path: str | Path) -> Path:
         plt.close(fig)
 
 
-def _subsample(n: int, limit: int, seed: int) -> NDArray[np.int64]:
+def subsample_rows(n: int, limit: int, seed: int) -> NDArray[np.int64]:
+    """At most ``limit`` sorted row indices of ``n``, drawn without replacement from ``seed``."""
     if n <= limit:
         return np.arange(n)
     return np.sort(make_rng(seed, "report", "subsample").choice(n, limit, replace=False))
@@ -66,7 +67,7 @@ def plot_classified_cloud(
     seed: int = 0,
 ) -> Path:
     """The whole cloud from above; prompted points in their prompt's colour, the rest grey."""
-    rows = _subsample(points.shape[0], max_points, seed)
+    rows = subsample_rows(points.shape[0], max_points, seed)
     colours = prompt_colours(prompts)
     fig, ax = plt.subplots(figsize=(9, 8))
     grey = rows[classes[rows] == UNCLASSIFIED]
@@ -123,7 +124,7 @@ def plot_place_layer(path: str | Path, build: TerrainBuild, max_points: int = 15
     layer = scene.layer1
     fig, ax = plt.subplots(figsize=(9, 8))
     if layer is not None:
-        rows = _subsample(layer.points.shape[0], max_points, 1)
+        rows = subsample_rows(layer.points.shape[0], max_points, 1)
         tint = [colours[scene.prompts.all[c]] for c in layer.classes[rows]]
         ax.scatter(layer.points[rows, 0], layer.points[rows, 1], s=0.3, c=tint, alpha=0.25)
     graph = scene.graph
@@ -151,6 +152,11 @@ def _draw_box(ax, low: NDArray, high: NDArray, lift: float, colour: str) -> None
                 ax.plot(*corners[[i, j]].T, color=colour, linewidth=1.0)
 
 
+def layer_lifts(span: float) -> dict[int, float]:
+    """Height each of layers 2-5 is drawn above the points, as a share of the map's width."""
+    return {layer: 0.12 * (layer - 1) * span for layer in (2, 3, 4, 5)}
+
+
 def plot_layered_graph(path: str | Path, build: TerrainBuild, max_points: int = 60_000) -> Path:
     """001 Fig 1: layer 1 points at the bottom, then objects, places, regions and the root."""
     scene, graph = build.scene, build.scene.graph
@@ -161,7 +167,7 @@ def plot_layered_graph(path: str | Path, build: TerrainBuild, max_points: int = 
     if scene.layer1 is not None and scene.layer1.points.shape[0]:
         pts = scene.layer1.points
         span = float(np.ptp(pts[:, :2], axis=0).max()) or 1.0
-        rows = _subsample(pts.shape[0], max_points, 2)
+        rows = subsample_rows(pts.shape[0], max_points, 2)
         n_terrain = len(scene.prompts.terrain)
         # 001 Fig 1: objects black, terrain types in shades of grey
         shade = np.where(
@@ -172,7 +178,7 @@ def plot_layered_graph(path: str | Path, build: TerrainBuild, max_points: int = 
         ax.scatter(
             pts[rows, 0], pts[rows, 1], pts[rows, 2], s=0.2, c=shade, cmap="gray", vmin=0, vmax=1
         )
-    lift = {2: 0.12 * span, 3: 0.24 * span, 4: 0.36 * span, 5: 0.48 * span}
+    lift = layer_lifts(span)
 
     def at(node: str) -> NDArray[np.float64]:
         data = graph.nodes[node]

@@ -35,12 +35,11 @@ from typing import Any, Literal
 
 import numpy as np
 import trimesh
-import yaml
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from seminspect.core.errors import FileFormatError, InvalidInputError
-from seminspect.core.io import atomic_write_bytes, read_json, write_versioned_json
+from seminspect.core.io import atomic_write_bytes, read_json, read_yaml, write_versioned_json
 from seminspect.worlds.builder import WorldBuilder
 from seminspect.worlds.shapes import pose_matrix
 from seminspect.worlds.world import BACKGROUND, World
@@ -104,7 +103,7 @@ class _Labels(BaseModel):
 # --------------------------------------------------------------------------------- reading
 def _read_labels(path: Path) -> _Labels:
     is_yaml = path.suffix.lower() in (".yaml", ".yml")
-    document = _read_yaml(path) if is_yaml else read_json(path)
+    document = read_yaml(path) if is_yaml else read_json(path)
     if not isinstance(document, dict):
         raise FileFormatError(f"{path}: expected a mapping at the top level")
     try:
@@ -113,19 +112,6 @@ def _read_labels(path: Path) -> _Labels:
         first = exc.errors()[0]
         where = ".".join(str(part) for part in first["loc"]) or "document"
         raise FileFormatError(f"{path}: {where}: {first['msg']}") from None
-
-
-def _read_yaml(path: Path) -> Any:
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise FileFormatError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise FileFormatError(f"{path}: cannot read ({exc})") from None
-    try:
-        return yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise FileFormatError(f"{path}: malformed YAML: {str(exc).splitlines()[0]}") from None
 
 
 def _obj_mesh(path: Path) -> tuple[NDArray, NDArray, list[str], NDArray]:

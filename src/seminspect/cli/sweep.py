@@ -1,0 +1,112 @@
+"""``seminspect sweep``: many missions as Ray tasks, one table of 000 Tables 3 and 6 columns."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import typer
+
+from seminspect.cli._common import console, err_console
+
+
+def parse_seeds(text: str) -> list[int]:
+    """``"0-4"``, ``"0,2,5"`` or a mix, as a sorted list of distinct seeds."""
+    from seminspect.core.errors import InvalidInputError
+
+    seeds: set[int] = set()
+    for part in filter(None, (p.strip() for p in text.split(","))):
+        low, dash, high = part.partition("-")
+        try:
+            first, last = int(low), int(high if dash else low)
+        except ValueError:
+            raise InvalidInputError(f"--seeds takes e.g. '0-4' or '0,2,5', got {text!r}") from None
+        if first < 0 or last < first:
+            raise InvalidInputError(f"--seeds range {part!r} is empty or negative")
+        seeds.update(range(first, last + 1))
+    if not seeds:
+        raise InvalidInputError("--seeds names no seed")
+    return sorted(seeds)
+
+
+def parse_settings(items: list[str]) -> dict[str, list[Any]]:
+    """``KEY=V1,V2`` items; values are read as YAML scalars (numbers, true/false, names)."""
+    import yaml
+
+    from seminspect.core.errors import InvalidInputError
+
+    settings: dict[str, list[Any]] = {}
+    for item in items:
+        key, sep, values = item.partition("=")
+        if not sep or not key.strip() or not values.strip():
+            raise InvalidInputError(f"--set takes KEY=VALUE[,VALUE...], got {item!r}")
+        settings[key.strip()] = [yaml.safe_load(v.strip()) for v in values.split(",")]
+    return settings
+
+
+def app(
+    grid: Path | None = typer.Option(
+        None, "--grid", help="YAML grid: worlds, scenarios, seeds, settings (see docs/sweeps.md)."
+    ),
+    world: list[str] = typer.Option([], "--world", "-w", help="World (repeatable)."),
+    scenario: list[str] = typer.Option([], "--scenario", "-s", help="Scenario (repeatable)."),
+    seeds: str = typer.Option("0", "--seeds", help="Seeds, e.g. '0-4' or '0,2,5'."),
+    setting: list[str] = typer.Option(
+        [], "--set", help="Mission setting and its values, e.g. planner=hierarchical,volumetric."
+    ),
+    out: Path = typer.Option(Path("runs/sweep"), "--out", "-o", help="Sweep directory."),
+    workers: int | None = typer.Option(
+        None, "--workers", min=1, help="Local Ray workers (default: one per core)."
+    ),
+    address: str | None = typer.Option(
+        None, "--address", help="Address of a running Ray cluster (e.g. ray://head:10001)."
+    ),
+) -> None:
+    """Run every mission of a grid (worlds x scenarios x seeds x settings) as Ray tasks.
+
+    Each mission writes its own run directory under --out and finished runs of the same
+    configuration are reused; a failed mission is reported and the sweep goes on. Writes
+    sweep.csv, sweep.json and sweep.md (per-run rows, mean and spread per group).
+    """
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from seminspect.core.errors import InvalidInputError
+    from seminspect.missions.sweep import SweepSpec, expand, load_spec, run_on_ray, sweep_tables
+
+    if grid is not None:
+        if world or scenario or setting:
+            raise InvalidInputError("give either --grid or --world/--scenario/--set, not both")
+        spec = load_spec(grid)
+    else:
+        spec = SweepSpec(
+            worlds=world or ["city"],
+            scenarios=list(scenario) or [None],
+            seeds=parse_seeds(seeds),
+            settings=parse_settings(setting),
+        )
+    tasks = expand(spec, out)
+    out.mkdir(parents=True, exist_ok=True)
+    columns = (
+        TextColumn("[bold]sweep"), BarColumn(), MofNCompleteColumn(),
+        TextColumn("missions  {task.fields[failed]} failed  {task.fields[last]}"),
+        TimeElapsedColumn(),
+    )  # fmt: skip
+    with Progress(*columns, console=err_console, transient=True) as progress:
+        bar = progress.add_task("sweep", total=len(tasks), failed=0, last="")
+        failed = 0
+
+        def show(row) -> None:
+            nonlocal failed
+            failed += row.state == "failed"
+            progress.update(bar, advance=1, failed=failed, last=f"{row.name}: {row.state}")
+
+        rows = run_on_ray(tasks, workers=workers, address=address, on_row=show)
+    written = sweep_tables(rows, out)
+    console.print((out / "sweep.md").read_text(encoding="utf-8"), markup=False, highlight=False)
+    console.print(f"tables: {', '.join(str(p) for p in written)}", highlight=False)
+    failures = [r for r in rows if r.state == "failed"]
+    for row in failures:
+        err_console.print(f"failed: {row.name}: {row.error}", highlight=False, soft_wrap=True)
+    if failures:
+        err_console.print(f"{len(failures)} of {len(rows)} missions failed", highlight=False)
+        raise typer.Exit(1)

@@ -1,0 +1,361 @@
+"""ROS bags in and out: labelled ``PointCloud2`` scans with ``Odometry``, through ``rosbags``.
+
+``rosbags`` is pure Python and reads ROS1 ``.bag`` files and ROS2 bag directories (sqlite3 or
+mcap) without a ROS installation. What seminspect reads from a bag:
+
+* a ``sensor_msgs/PointCloud2`` topic: ``x``, ``y``, ``z`` per point in the sensor frame and,
+  optionally, an integer label field (SemanticKITTI's packing is understood: the semantic id is
+  the lower 16 bits of a 32-bit label, the instance id the upper 16);
+* a ``nav_msgs/Odometry`` topic: the sensor's pose in the map frame. Each cloud takes the pose
+  interpolated at its header stamp (linear in position, slerp in rotation) between the two
+  odometry messages around it; a cloud outside the odometry's time span by more than
+  :data:`MAX_POSE_GAP_S` is refused. TF is not read: the cloud's frame must be the odometry's
+  child frame (true of the bags :func:`write_bag` makes);
+* optionally a ``std_msgs/String`` topic :data:`LABEL_NAMES_TOPIC` holding a JSON object of
+  label id -> class name, which :func:`write_bag` adds so the bag names its own labels.
+
+Fusing the scans into 001's metric-semantic cloud (Sec III-A.3) is
+:func:`seminspect.mapping.ingest.integrate_labelled_scan`, one view per cloud.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from collections.abc import Callable, Iterable, Iterator, Mapping
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation, Slerp
+
+from seminspect.core.errors import FileFormatError, InvalidInputError
+from seminspect.mapping.ingest import integrate_labelled_scan
+from seminspect.mapping.semantic_cloud import SemanticCloud, as_transform
+from seminspect.perception.encoders import Encoder
+
+#: A cloud may be this far outside the odometry's span and still take its end pose.
+MAX_POSE_GAP_S = 0.1
+LABEL_NAMES_TOPIC = "/seminspect/label_names"
+CLOUD_TYPE = "sensor_msgs/msg/PointCloud2"
+ODOMETRY_TYPE = "nav_msgs/msg/Odometry"
+STRING_TYPE = "std_msgs/msg/String"
+#: sensor_msgs/PointField datatypes as numpy types.
+_FIELD_TYPES = {1: "i1", 2: "u1", 3: "i2", 4: "u2", 5: "i4", 6: "u4", 7: "f4", 8: "f8"}
+_LABEL_FIELD_TYPE = 6  # uint32, as SemanticKITTI stores labels
+
+
+@dataclass(frozen=True)
+class BagScan:
+    """One cloud of a bag: its points in the sensor frame, labels, and the sensor's pose.
+
+    Attributes:
+        stamp_ns: header stamp in nanoseconds.
+        points: ``(N, 3)`` float, sensor frame.
+        labels: ``(N,)`` int semantic ids, or ``None`` when no label field was asked for.
+        pose: ``(4, 4)`` float ``T_map_sensor``.
+    """
+
+    stamp_ns: int
+    points: NDArray[np.float64]
+    labels: NDArray[np.int64] | None
+    pose: NDArray[np.float64]
+
+
+def _typestore():
+    try:
+        from rosbags.typesys import Stores, get_typestore  # noqa: PLC0415 - optional dependency
+    except ImportError:
+        raise InvalidInputError(
+            "ROS bags need the 'rosbags' package: pip install 'seminspect[ros]'"
+        ) from None
+    return get_typestore(Stores.ROS2_HUMBLE)
+
+
+@contextmanager
+def _opened(path: str | os.PathLike[str]) -> Iterator[Any]:
+    """An open ``AnyReader`` over one ROS1 or ROS2 bag; unreadable bags are a FileFormatError."""
+    typestore = _typestore()
+    from rosbags.highlevel import AnyReader  # noqa: PLC0415 - optional dependency
+
+    source = Path(path)
+    if not source.exists():
+        raise InvalidInputError(f"{source}: no such bag")
+    reader = AnyReader([source], default_typestore=typestore)
+    try:
+        reader.open()
+    except Exception as exc:  # rosbags raises its own error type per bag format
+        raise FileFormatError(f"{source}: not a readable ROS bag ({exc})") from None
+    try:
+        yield reader
+    finally:
+        reader.close()
+
+
+def _stamp_ns(header) -> int:
+    return int(header.stamp.sec) * 1_000_000_000 + int(header.stamp.nanosec)
+
+
+def cloud_arrays(
+    message, labels_field: str | None = None
+) -> tuple[NDArray[np.float64], NDArray[np.int64] | None]:
+    """Finite ``x y z`` points ``(N, 3)`` of a ``PointCloud2`` and its labels (lower 16 bits)."""
+    fields = {f.name: f for f in message.fields}
+    wanted = ["x", "y", "z", *([labels_field] if labels_field else [])]
+    missing = [name for name in wanted if name not in fields]
+    if missing:
+        raise FileFormatError(
+            f"the clouds have no field {missing[0]!r} (fields: {', '.join(fields)})"
+        )
+    for name in wanted:
+        if fields[name].datatype not in _FIELD_TYPES or fields[name].count != 1:
+            raise FileFormatError(f"cloud field {name!r} is not a single number")
+    order = ">" if message.is_bigendian else "<"
+    dtype = np.dtype(
+        {
+            "names": wanted,
+            "formats": [order + _FIELD_TYPES[fields[n].datatype] for n in wanted],
+            "offsets": [fields[n].offset for n in wanted],
+            "itemsize": message.point_step,
+        }
+    )
+    count = message.width * message.height
+    raw = np.asarray(message.data, dtype=np.uint8)
+    if message.point_step <= 0 or raw.size < count * message.point_step:
+        raise FileFormatError(f"a cloud holds {raw.size} bytes for {count} points")
+    rows = np.frombuffer(raw[: count * message.point_step].tobytes(), dtype=dtype)
+    points = np.column_stack([rows["x"], rows["y"], rows["z"]]).astype(np.float64)
+    finite = np.all(np.isfinite(points), axis=1)
+    labels = None
+    if labels_field:
+        labels = (rows[labels_field].astype(np.int64) & 0xFFFF)[finite]
+    return points[finite], labels
+
+
+def _odometry_track(reader, connections) -> tuple[NDArray[np.int64], NDArray, NDArray]:
+    stamps, positions, rotations = [], [], []
+    for connection, _, raw in reader.messages(connections=connections):
+        message = reader.deserialize(raw, connection.msgtype)
+        pose = message.pose.pose
+        stamps.append(_stamp_ns(message.header))
+        positions.append([pose.position.x, pose.position.y, pose.position.z])
+        q = pose.orientation
+        rotations.append([q.x, q.y, q.z, q.w])
+    if not stamps:
+        raise FileFormatError("the odometry topic has no messages")
+    order = np.argsort(stamps, kind="stable")
+    return np.asarray(stamps)[order], np.asarray(positions)[order], np.asarray(rotations)[order]
+
+
+class PoseTrack:
+    """Sensor poses interpolated over odometry stamps."""
+
+    def __init__(self, stamps: NDArray[np.int64], positions: NDArray, quaternions: NDArray):
+        norms = np.linalg.norm(quaternions, axis=1)
+        if not np.all(np.isfinite(positions)) or not np.all(norms > 0.5):
+            raise FileFormatError("the odometry holds NaN poses or non-unit orientations")
+        self.stamps, self.positions = stamps, positions
+        self.rotations = Rotation.from_quat(quaternions / norms[:, None])
+        self.slerp = Slerp(stamps.astype(float), self.rotations) if len(stamps) > 1 else None
+
+    def at(self, stamp_ns: int) -> NDArray[np.float64]:
+        first, last = int(self.stamps[0]), int(self.stamps[-1])
+        gap_s = max(first - stamp_ns, stamp_ns - last, 0) / 1e9
+        if gap_s > MAX_POSE_GAP_S:
+            raise InvalidInputError(
+                f"a cloud at {stamp_ns / 1e9:.3f} s is {gap_s:.2f} s outside the odometry "
+                f"({first / 1e9:.3f}-{last / 1e9:.3f} s)"
+            )
+        t = float(min(max(stamp_ns, first), last))
+        transform = np.eye(4)
+        transform[:3, 3] = [np.interp(t, self.stamps, self.positions[:, i]) for i in range(3)]
+        rotation = self.slerp([t])[0] if self.slerp is not None else self.rotations[0]
+        transform[:3, :3] = rotation.as_matrix()
+        return transform
+
+
+def _topic_connections(reader, topic: str, msgtype: str) -> list:
+    found = [c for c in reader.connections if c.topic == topic]
+    if not found:
+        topics = sorted({c.topic for c in reader.connections})
+        raise InvalidInputError(f"the bag has no topic {topic!r} (topics: {', '.join(topics)})")
+    if any(c.msgtype != msgtype for c in found):
+        raise InvalidInputError(f"topic {topic!r} is {found[0].msgtype}, not {msgtype}")
+    return found
+
+
+def read_bag_scans(
+    path: str | os.PathLike[str],
+    cloud_topic: str,
+    odom_topic: str,
+    labels_field: str | None = None,
+) -> Iterator[BagScan]:
+    """Every cloud of ``cloud_topic`` in bag order, posed from ``odom_topic``."""
+    with _opened(path) as reader:
+        track = PoseTrack(
+            *_odometry_track(reader, _topic_connections(reader, odom_topic, ODOMETRY_TYPE))
+        )
+        clouds = _topic_connections(reader, cloud_topic, CLOUD_TYPE)
+        for connection, _, raw in reader.messages(connections=clouds):
+            message = reader.deserialize(raw, connection.msgtype)
+            stamp = _stamp_ns(message.header)
+            points, labels = cloud_arrays(message, labels_field)
+            yield BagScan(stamp, points, labels, track.at(stamp))
+
+
+def read_label_names(path: str | os.PathLike[str]) -> dict[int, str] | None:
+    """The label names a bag carries on :data:`LABEL_NAMES_TOPIC`, or ``None``."""
+    with _opened(path) as reader:
+        found = [c for c in reader.connections if c.topic == LABEL_NAMES_TOPIC]
+        for connection, _, raw in reader.messages(connections=found):
+            text = reader.deserialize(raw, connection.msgtype).data
+            try:
+                return {int(k): str(v) for k, v in json.loads(text).items()}
+            except (ValueError, AttributeError):
+                raise FileFormatError(f"{path}: {LABEL_NAMES_TOPIC} is not a JSON object") from None
+    return None
+
+
+def fuse_bag(
+    scans: Iterable[BagScan],
+    names: Mapping[int, str],
+    encoder: Encoder,
+    radius: float,
+    on_scan: Callable[[int], None] | None = None,
+) -> SemanticCloud:
+    """001's metric-semantic cloud (Sec III-A.3) from labelled bag scans, one view per cloud."""
+    cloud = SemanticCloud.empty(encoder.dim, encoder.name)
+    count = 0
+    for scan in scans:
+        if scan.labels is None:
+            raise InvalidInputError("fusing a bag needs per-point labels (give --labels-field)")
+        integrate_labelled_scan(
+            cloud, scan.points, scan.labels, scan.pose, names=names, encoder=encoder, radius=radius
+        )
+        count += 1
+        if on_scan:
+            on_scan(count)
+    if count == 0:
+        raise InvalidInputError("the cloud topic has no messages")
+    return cloud
+
+
+# --- writing -----------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class BagTopics:
+    """Topic and frame names of a bag :func:`write_bag` makes."""
+
+    cloud: str = "/points"
+    odometry: str = "/odom"
+    map_frame: str = "map"
+    sensor_frame: str = "lidar"
+
+
+def write_bag(
+    path: str | os.PathLike[str],
+    scans: Iterable[BagScan],
+    label_names: Mapping[int, str] | None = None,
+    topics: BagTopics = BagTopics(),
+) -> Path:
+    """Write scans as ``PointCloud2`` (x, y, z float32, label uint32) plus ``Odometry``.
+
+    The bag is a ROS2 bag directory (sqlite3, ROS2 Humble message definitions); ROS1 bags are
+    read, not written. It appears only when complete: written beside, then renamed into place.
+    """
+    target = Path(path)
+    if target.exists():
+        raise InvalidInputError(f"{target} exists; choose a new bag name")
+    typestore = _typestore()
+    from rosbags.rosbag2 import Writer  # noqa: PLC0415 - optional dependency
+
+    partial = target.with_name(f".{target.name}.partial")
+    if partial.exists():
+        _remove(partial)
+    try:
+        with Writer(partial, version=9) as writer:
+            _write_messages(writer, typestore, scans, label_names, topics)
+        partial.rename(target)
+    except BaseException:
+        _remove(partial)
+        raise
+    return target
+
+
+def _remove(path: Path) -> None:
+    if path.is_dir():
+        shutil.rmtree(path)
+    else:
+        path.unlink(missing_ok=True)
+
+
+def _write_messages(writer, typestore, scans, label_names, topics: BagTopics) -> None:
+    serialize = typestore.serialize_cdr
+    types = typestore.types
+    clouds = writer.add_connection(topics.cloud, CLOUD_TYPE, typestore=typestore)
+    odometry = writer.add_connection(topics.odometry, ODOMETRY_TYPE, typestore=typestore)
+    names_written = label_names is None
+    for scan in scans:
+        header = _header(types, scan.stamp_ns, topics.sensor_frame)
+        if not names_written:
+            connection = writer.add_connection(LABEL_NAMES_TOPIC, STRING_TYPE, typestore=typestore)
+            text = json.dumps({str(k): v for k, v in sorted(label_names.items())})
+            writer.write(
+                connection, scan.stamp_ns, serialize(types[STRING_TYPE](text), STRING_TYPE)
+            )
+            names_written = True
+        odom = _odometry_message(types, scan, topics)
+        writer.write(odometry, scan.stamp_ns, serialize(odom, ODOMETRY_TYPE))
+        writer.write(
+            clouds, scan.stamp_ns, serialize(_cloud_message(types, header, scan), CLOUD_TYPE)
+        )
+
+
+def _header(types, stamp_ns: int, frame: str):
+    stamp = types["builtin_interfaces/msg/Time"](
+        sec=stamp_ns // 1_000_000_000, nanosec=stamp_ns % 1_000_000_000
+    )
+    return types["std_msgs/msg/Header"](stamp=stamp, frame_id=frame)
+
+
+def _cloud_message(types, header, scan: BagScan):
+    field = types["sensor_msgs/msg/PointField"]
+    rows = np.zeros(
+        len(scan.points), dtype=[("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("label", "<u4")]
+    )
+    for axis, name in enumerate("xyz"):
+        rows[name] = scan.points[:, axis]
+    if scan.labels is not None:
+        rows["label"] = scan.labels
+    fields = [field(name=n, offset=4 * i, datatype=7, count=1) for i, n in enumerate("xyz")]
+    fields.append(field(name="label", offset=12, datatype=_LABEL_FIELD_TYPE, count=1))
+    return types[CLOUD_TYPE](
+        header=header, height=1, width=len(rows), fields=fields, is_bigendian=False,
+        point_step=16, row_step=16 * len(rows), data=rows.view(np.uint8).reshape(-1),
+        is_dense=True,
+    )  # fmt: skip
+
+
+def _odometry_message(types, scan: BagScan, topics: BagTopics):
+    pose = as_transform(scan.pose, "scan pose")
+    x, y, z, w = Rotation.from_matrix(pose[:3, :3]).as_quat()
+    geometry = types["geometry_msgs/msg/Pose"](
+        position=types["geometry_msgs/msg/Point"](*pose[:3, 3].tolist()),
+        orientation=types["geometry_msgs/msg/Quaternion"](x=x, y=y, z=z, w=w),
+    )
+    covariance = np.zeros(36)
+    twist = types["geometry_msgs/msg/Twist"](
+        linear=types["geometry_msgs/msg/Vector3"](0.0, 0.0, 0.0),
+        angular=types["geometry_msgs/msg/Vector3"](0.0, 0.0, 0.0),
+    )
+    return types[ODOMETRY_TYPE](
+        header=_header(types, scan.stamp_ns, topics.map_frame),
+        child_frame_id=topics.sensor_frame,
+        pose=types["geometry_msgs/msg/PoseWithCovariance"](pose=geometry, covariance=covariance),
+        twist=types["geometry_msgs/msg/TwistWithCovariance"](twist=twist, covariance=covariance),
+    )
