@@ -58,6 +58,8 @@ def synthetic_graph(
     tree_points: list[np.ndarray] = []
     for k in order:
         target = by_index[k]
+        if target.id not in graph:  # pruned by a close neighbour's inspection (eq 10's polygon)
+            continue
         _inspect(
             graph,
             target.id,
