@@ -14,6 +14,7 @@ import os
 import sys
 import warnings
 from collections.abc import Iterator, Sequence
+from typing import Any
 
 import typer
 from pydantic import ValidationError
@@ -117,15 +118,18 @@ def _report(exc: BaseException) -> int:
     elif isinstance(exc, _USAGE_ERROR):
         code = 0 if type(exc).__name__ == "NoArgsIsHelpError" else 2  # 0: the help was printed
         if code:
-            command = exc.ctx.command_path if exc.ctx else "seminspect"
-            _error("error:", f"{exc.format_message()} (see '{command} --help')")
+            usage: Any = exc  # click's UsageError, found at import time (see _USAGE_ERROR)
+            command = usage.ctx.command_path if usage.ctx else "seminspect"
+            _error("error:", f"{usage.format_message()} (see '{command} --help')")
     elif isinstance(exc, KeyboardInterrupt | typer.Abort):
         stop = as_interrupted(exc) if isinstance(exc, KeyboardInterrupt) else Interrupted()
         err_console.print(stop.describe(), highlight=False)
         code = stop.exit_code
     elif isinstance(exc, SeminspectError | ValidationError):
-        is_validation = isinstance(exc, ValidationError)
-        _error("error:", describe_validation_error(exc, "value") if is_validation else exc)
+        _error(
+            "error:",
+            describe_validation_error(exc, "value") if isinstance(exc, ValidationError) else exc,
+        )
         code = 1
     elif isinstance(exc, OSError) and exc.filename is not None:
         # a file the user named could not be read or written: their fix, not a bug

@@ -141,7 +141,7 @@ def _resumed(ctx: typer.Context, run_dir: Path):
             "budget",
             "out",
         )
-        if ctx.get_parameter_source(name).name != "DEFAULT"
+        if getattr(ctx.get_parameter_source(name), "name", "DEFAULT") != "DEFAULT"
     ]
     if given:
         raise InvalidInputError(

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
@@ -161,7 +162,7 @@ def record_prior(
     return prior
 
 
-def load_prior(path: str | Path, resolution: float) -> VoxelMap:
+def load_prior(path: str | os.PathLike[str], resolution: float) -> VoxelMap:
     """A historical map from a file: a seminspect map (``.npz``), an OctoMap (``.bt``) or a
     point cloud (``.ply``/``.pcd``: occupied cells, the rest unknown)."""
     source = Path(path)
@@ -299,17 +300,18 @@ class RoutineMission:
             if not len(plan.positions):
                 self.tasks[i].skipped = "every view pose collides on M_H"
         while pending:
-            chosen, route = self._next_task(pending)
-            if chosen is None:
+            selected = self._next_task(pending)
+            if selected is None:
                 for i in pending:
                     self.tasks[i].skipped = "no route over M_H"
                 break
+            chosen, route = selected
             pending.remove(chosen)
             self._run_task(chosen, route)
         done = sum(t.completed for t in self.tasks)
         return f"{done} of {len(self.tasks)} tasks completed"
 
-    def _next_task(self, pending: list[int]) -> tuple[int | None, NDArray | None]:
+    def _next_task(self, pending: list[int]) -> tuple[int, NDArray[np.float64]] | None:
         """EvalInspectionTasks: the task with the shortest route over M_H (and that route)."""
         best: tuple[float, int, NDArray] | None = None
         for i in pending:
@@ -323,7 +325,7 @@ class RoutineMission:
             if best is None or path.length < best[0]:
                 best = (path.length, i, path.waypoints)
         if best is None:
-            return None, None
+            return None
         self._event("task-selected", task=self.plans[best[1]].region.name, route_m=best[0])
         return best[1], best[2]
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import numpy as np
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
@@ -51,7 +52,10 @@ def load_tasks(path: str | os.PathLike[str]) -> list[InspectionRegion]:
     if len(set(names)) != len(names):
         raise FileFormatError(f"{source}: region names must be unique, got {names}")
     try:
-        return [InspectionRegion(r.name, r.vertices) for r in parsed.regions]
+        return [
+            InspectionRegion(r.name, np.asarray(r.vertices, dtype=np.float64))
+            for r in parsed.regions
+        ]
     except InvalidInputError as exc:
         raise FileFormatError(f"{source}: {exc}") from None
 

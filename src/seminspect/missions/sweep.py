@@ -46,6 +46,8 @@ from seminspect.missions.run import run_mission, run_name
 from seminspect.missions.rundir import read_run_metrics, reusable_run
 
 TABLE_FILES = ("sweep.csv", "sweep.json", "sweep.md")
+#: A grid without scenarios runs each world's default one.
+_DEFAULT_SCENARIO: str | None = None
 
 
 class SweepSpec(BaseModel):
@@ -54,7 +56,7 @@ class SweepSpec(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
     worlds: list[str] = Field(min_length=1)
-    scenarios: list[str | None] = Field(default_factory=lambda: [None], min_length=1)
+    scenarios: list[str | None] = Field(default_factory=lambda: [_DEFAULT_SCENARIO], min_length=1)
     seeds: list[int] = Field(default_factory=lambda: [0], min_length=1)
     settings: dict[str, list[Any]] = Field(default_factory=dict)
 

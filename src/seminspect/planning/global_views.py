@@ -142,7 +142,7 @@ def grid_points(region: InspectionRegion, constraints: ViewConstraints) -> NDArr
 def _centred_lines(low: float, high: float, spacing: float) -> NDArray[np.float64]:
     count = math.floor((high - low) / spacing) + 1
     middle = 0.5 * (low + high)
-    return middle + spacing * (np.arange(count) - (count - 1) / 2)
+    return middle + spacing * (np.arange(count, dtype=np.float64) - (count - 1) / 2)
 
 
 def outward_normal(

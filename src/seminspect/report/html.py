@@ -381,7 +381,9 @@ def _thumbnails(root: Path, images: Iterable[str]) -> dict[str, str]:
         small = cv2.resize(image, (THUMBNAIL_WIDTH, height), interpolation=cv2.INTER_AREA)
         ok, encoded = cv2.imencode(".jpg", small, [cv2.IMWRITE_JPEG_QUALITY, THUMBNAIL_QUALITY])
         if ok:
-            thumbnails[relative] = "data:image/jpeg;base64," + base64.b64encode(encoded).decode()
+            thumbnails[relative] = (
+                "data:image/jpeg;base64," + base64.b64encode(encoded.tobytes()).decode()
+            )
     return thumbnails
 
 
