@@ -113,16 +113,15 @@ def app(
 
 def _print_result(result) -> None:
     metrics = result.metrics
-    t3, t6, mission = metrics["table3"], metrics["table6"], metrics["mission"]
+    t3, t6, mission = metrics.table3, metrics.table6, metrics.mission
     console.print(f"[bold]{result.state}[/]: {result.reason}")
     console.print(
-        f"targets detected {t3['detected_pct']:.0f}%, inspected {t3['inspected_pct']:.0f}% of "
-        f"detected; localisation RMSE {_m(t6['localisation_rmse_m'])}; "
-        f"{mission['sim_time_s']:.0f} s simulated in {mission['wall_time_s']:.0f} s"
+        f"targets detected {t3.detected_pct:.0f}%, inspected {t3.inspected_pct:.0f}% of "
+        f"detected; localisation RMSE {_m(t6.localisation_rmse_m)}; "
+        f"{mission.sim_time_s:.0f} s simulated in {mission.wall_time_s:.0f} s"
     )
     console.print(
-        f"3DLSG: {t3['unified'][0]} nodes, {t3['unified'][1]} edges "
-        f"(reconciled {t3['reconciled_pct']:.1f}%)"
+        f"3DLSG: {t3.unified[0]} nodes, {t3.unified[1]} edges (reconciled {t3.reconciled_pct:.1f}%)"
     )
     for answer in result.answers:
         outcome = "reached" if answer.reached else f"not reached ({answer.error or 'too far'})"
