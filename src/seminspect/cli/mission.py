@@ -71,7 +71,7 @@ def app(
 
     from seminspect.missions.config import make_config
     from seminspect.missions.run import run_mission
-    from seminspect.report.mission import render_run
+    from seminspect.report.run_pictures import render_run
 
     config = make_config(
         {

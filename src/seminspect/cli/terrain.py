@@ -125,7 +125,7 @@ def _quality(build, cloud, fused, encoder) -> dict[str, Any]:
 
 
 def _write_outputs(out: Path, build, cloud, progress) -> None:
-    from seminspect.graphs.terrain.serialization import save_terrain_graph, write_graphml
+    from seminspect.graphs.terrain.io import save_terrain_graph, write_graphml
     from seminspect.report.terrain import (
         plot_classified_cloud,
         plot_gvd_stages,
@@ -242,8 +242,8 @@ def route(
     terrain: str | None = typer.Option(None, help="Terrain types allowed, comma-separated."),
 ) -> None:
     """Shortest route between two places over the chosen terrain types."""
+    from seminspect.graphs.terrain.io import load_terrain_graph
     from seminspect.graphs.terrain.navigation import shortest_route
-    from seminspect.graphs.terrain.serialization import load_terrain_graph
 
     scene = load_terrain_graph(graph_file)
     allowed = [t.strip() for t in terrain.split(",") if t.strip()] if terrain else None

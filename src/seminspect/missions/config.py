@@ -11,8 +11,8 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from seminspect.core.config import build
 from seminspect.core.params import PRESETS, InspectionParams, PresetName
+from seminspect.core.validation import build
 from seminspect.core.vocabulary import BUILDING_FEATURES, VEHICLE_PARTS
 
 Mode = Literal["ground", "aerial"]

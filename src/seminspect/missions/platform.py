@@ -23,8 +23,8 @@ from seminspect.geometry.transforms import as_point, wrap_angle
 from seminspect.robot import Robot
 from seminspect.robot.robot import MoveResult
 from seminspect.sensors import CameraModel, Detection, Frame, Lidar, LidarScan, render
-from seminspect.sensors.detection import detect
 from seminspect.sensors.noise import NoiseModel, make_noise
+from seminspect.sensors.segmentation import detect
 from seminspect.worlds import World
 
 

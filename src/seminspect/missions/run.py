@@ -36,8 +36,8 @@ from seminspect.missions.metrics import (
     TargetFigures,
 )
 from seminspect.missions.platform import SimulatedPlatform, mission_noise
-from seminspect.missions.report import summary_markdown
 from seminspect.missions.rundir import RunDirectory
+from seminspect.missions.summary import summary_markdown
 from seminspect.missions.xflie import MissionProgress, XFlie
 from seminspect.worlds import World, generate_world
 

@@ -36,8 +36,8 @@ from pydantic import BaseModel, ConfigDict, Field
 from scipy import ndimage
 from shapely.geometry import Polygon
 
-from seminspect.core.config import build
 from seminspect.core.errors import InvalidInputError, PlanningError
+from seminspect.core.validation import build
 from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.graphs.terrain.evaluate import (
     closest_class,

@@ -34,7 +34,6 @@ from seminspect.core.io import (
 )
 from seminspect.core.params import make_params
 from seminspect.graphs.lsg import naming
-from seminspect.graphs.lsg.convert import node_attributes, to_networkx
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.model import (
     EdgeKind,
@@ -46,6 +45,7 @@ from seminspect.graphs.lsg.model import (
     TargetNode,
     TargetStatus,
 )
+from seminspect.graphs.lsg.networkx_view import node_attributes, to_networkx
 
 FORMAT = "seminspect.lsg"
 VERSION = 1

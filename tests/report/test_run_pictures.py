@@ -1,5 +1,5 @@
 from seminspect.missions.rundir import load_trajectory
-from seminspect.report.mission import load_events, render_run
+from seminspect.report.run_pictures import load_events, render_run
 
 
 def test_pictures_are_drawn_from_the_run_directory_alone(small_mission_dir) -> None:
