@@ -11,6 +11,7 @@ import importlib
 import os
 import sys
 from collections.abc import Sequence
+from typing import Any
 
 import typer
 from pydantic import ValidationError
@@ -21,7 +22,7 @@ from seminspect.core.errors import SeminspectError
 from seminspect.core.validation import describe_validation_error
 
 #: Typer ships its own click; take its usage-error class from a public exception's ancestry.
-_USAGE_ERROR = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "UsageError")
+_USAGE_ERROR: Any = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "UsageError")
 
 #: (module under seminspect.cli, group name, one-line help)
 #: Group modules import heavy dependencies inside their commands so ``--help`` stays fast.

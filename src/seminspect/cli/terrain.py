@@ -121,7 +121,9 @@ def _quality(build, cloud, fused, encoder) -> dict[str, Any]:
 
     if fused is not None:
         return _kitti_quality(build, fused, encoder)
-    return evaluate_on_world(build, source_world(cloud), encoder)
+    world = source_world(cloud)
+    assert world is not None, "the command checks for a source world before building"
+    return evaluate_on_world(build, world, encoder)
 
 
 def _write_outputs(out: Path, build, cloud, progress) -> None:

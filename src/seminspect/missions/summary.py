@@ -100,7 +100,6 @@ def summary_markdown(
                 f"| {a.query} | {a.goal or a.error} | {_fmt(time_ms, 3)} | "
                 f"{_fmt(a.path_length_m, 1)} | {'yes' if a.reached else 'no'} |"
             )
-    targets = graph.targets()
     lines += [
         "",
         "## Targets",
@@ -108,7 +107,7 @@ def summary_markdown(
         "| Target | Status | Levels | Poses | Features |",
         "|---|---|---|---|---|",
     ]
-    for t in targets:
+    for t in graph.targets():
         poses = [p for lv in t.levels for p in lv.poses]
         lines.append(
             f"| {t.id} | {t.status.value} | {len(t.levels)} | {len(poses)} | "

@@ -14,6 +14,7 @@ import math
 import statistics
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -94,7 +95,7 @@ def scaling_point(
     search, plan_s, settled, vp, expansions, ratio_search, ratio_plan = ([] for _ in range(7))
     failures = 0
     for start, goal in random_queries(graph, queries, seed):
-        route, timing = time_hierarchical(lambda s=start, g=goal: hierarchical.plan(g, s), repeats)
+        route, timing = time_hierarchical(partial(hierarchical.plan, goal, start), repeats)
         answer = time_volumetric(volumetric, start, route.waypoints[-1], repeats=1)
         search.append(timing.search_s)
         plan_s.append(timing.plan_s)

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Final, Literal
 
 import networkx as nx
 import numpy as np
@@ -48,8 +48,8 @@ from seminspect.graphs.lsg.model import (
 )
 from seminspect.graphs.lsg.networkx_view import node_attributes, to_networkx
 
-FORMAT = "seminspect.lsg"
-VERSION = 1
+FORMAT: Final = "seminspect.lsg"
+VERSION: Final = 1
 #: Structural limits that keep a hostile file from exhausting memory.
 MAX_ITEMS = 1_000_000
 
