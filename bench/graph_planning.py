@@ -29,7 +29,7 @@ from seminspect.graphs.lsg.networkx_view import traversable_networkx
 from seminspect.graphs.lsg.synthetic import synthetic_graph
 from seminspect.planning.graph_search import CsrGraph, shortest_path
 from seminspect.planning.hierarchical import HierarchicalPlanner
-from seminspect.planning.scaling import random_queries
+from seminspect.studies.planning.scaling import random_queries
 
 
 def flat_csr(flat: nx.Graph) -> tuple[CsrGraph, dict[str, int]]:

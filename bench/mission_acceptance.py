@@ -83,9 +83,9 @@ def main() -> None:
         config = resolve(make_config({"world": world, "scenario": scenario, "seed": seed}))
         out = Path(args.out) / name
         if args.reuse and reusable_run(out, config):
-            metrics = read_run_metrics(out)
+            metrics = read_run_metrics(out).to_json()
         else:
-            metrics = run_mission(config, out).metrics
+            metrics = run_mission(config, out).metrics.to_json()
         results.append({**metrics, "run": {"world": world, "scenario": scenario, "seed": seed}})
         print(row(world, scenario, seed, metrics), flush=True)
     city = [r for r in results if r["run"]["world"] == "city"]

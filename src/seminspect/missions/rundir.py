@@ -43,6 +43,7 @@ from seminspect.core.io import (
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.io import save_graph
 from seminspect.mapping.voxel import VoxelMap, save_map
+from seminspect.missions.metrics import MissionMetrics
 from seminspect.worlds import World, generate_world
 
 if TYPE_CHECKING:
@@ -137,9 +138,11 @@ def read_run_config(run_dir: Path) -> dict[str, Any]:
     return read_versioned_json(run_dir / "config.json", CONFIG_FORMAT, [1])["config"]
 
 
-def read_run_metrics(run_dir: Path) -> dict[str, Any]:
+def read_run_metrics(run_dir: Path) -> MissionMetrics:
     """The metrics a run wrote when it ended."""
-    return read_versioned_json(run_dir / "metrics.json", METRICS_FORMAT, [1])
+    return MissionMetrics.from_json(
+        read_versioned_json(run_dir / "metrics.json", METRICS_FORMAT, [1])
+    )
 
 
 def reusable_run(run_dir: Path, config: MissionConfig) -> bool:

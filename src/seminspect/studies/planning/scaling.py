@@ -25,11 +25,11 @@ from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.model import FeatureNode
 from seminspect.graphs.lsg.synthetic import VEHICLE_SIZE, synthetic_graph, synthetic_layout
 from seminspect.mapping.voxel import VoxelMap
-from seminspect.planning.comparison import time_hierarchical, time_volumetric
 from seminspect.planning.gridmap import CostModel
 from seminspect.planning.hierarchical import HierarchicalPlanner
 from seminspect.planning.local import DEFAULT_GROUND_BAND
 from seminspect.planning.volumetric import VolumetricPlanner
+from seminspect.studies.planning.comparison import time_hierarchical, time_volumetric
 
 #: City sizes (vehicles) of the default study: the paper's 20 up to a hundred times more.
 SCALING_SIZES = (20, 50, 100, 200, 500, 1000, 2000)

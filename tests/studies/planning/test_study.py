@@ -10,8 +10,12 @@ from seminspect.core.errors import InvalidInputError
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.synthetic import synthetic_graph
 from seminspect.mapping.voxel import VoxelMap, save_map
-from seminspect.missions import planning_study
-from seminspect.missions.planning_study import (
+from seminspect.missions.rundir import RunDirectory, reusable_run
+from seminspect.perception.observation import Observation
+from seminspect.planning.hierarchical import HierarchicalPlanner
+from seminspect.studies.planning import study as planning_study
+from seminspect.studies.planning.comparison import HierarchicalTiming, VolumetricResult
+from seminspect.studies.planning.study import (
     MissionOutcome,
     PathCheck,
     QueryComparison,
@@ -22,10 +26,6 @@ from seminspect.missions.planning_study import (
     select_queries,
     study_config,
 )
-from seminspect.missions.rundir import RunDirectory, reusable_run
-from seminspect.perception.observation import Observation
-from seminspect.planning.comparison import HierarchicalTiming, VolumetricResult
-from seminspect.planning.hierarchical import HierarchicalPlanner
 
 
 def test_queries_spread_from_the_nearest_to_the_farthest_target() -> None:
