@@ -41,20 +41,20 @@ def main() -> None:
         if profiler:
             profiler.disable()
         wall = time.perf_counter() - t0
-    mission = result.metrics["mission"]
-    factor = mission["sim_time_s"] / wall
+    mission = result.metrics.mission
+    factor = mission.sim_time_s / wall
     name = f"{args.world} {args.scenario} seed {args.seed}"
     print(f"mission {name}: {result.state} ({result.reason})")
     print(
-        f"simulated {mission['sim_time_s']:.0f} s in {wall:.1f} s wall: {factor:.1f}x real time "
+        f"simulated {mission.sim_time_s:.0f} s in {wall:.1f} s wall: {factor:.1f}x real time "
         f"(target {TARGET_FACTOR:.0f}x: {'met' if factor >= TARGET_FACTOR else 'missed'})"
     )
     print(
-        f"{mission['frames']} camera frames, {mission['lidar_scans']} LiDAR scans, "
-        f"{mission['local_plans']} local plans, {mission['hierarchical_queries']} hierarchical "
-        f"queries, {mission['distance_m']:.0f} m driven"
+        f"{mission.frames} camera frames, {mission.lidar_scans} LiDAR scans, "
+        f"{mission.local_plans} local plans, {mission.hierarchical_queries} hierarchical "
+        f"queries, {mission.distance_m:.0f} m driven"
     )
-    categories = mission["wall_time_by_category_s"]
+    categories = mission.wall_time_by_category_s
     other = wall - sum(categories.values())
     print("wall time by category:")
     for name, seconds in sorted(categories.items(), key=lambda item: -item[1]):

@@ -85,11 +85,11 @@ def main() -> None:
         out = Path(args.out) / name
         reuse = reusable_run(out, config) if args.reuse else None
         if reuse:
-            metrics = read_run_metrics(out)
+            metrics = read_run_metrics(out).to_json()
         else:
             if reuse is not None:
                 print(f"running {name} again: {reuse.reason}", file=sys.stderr, flush=True)
-            metrics = run_mission(config, out).metrics
+            metrics = run_mission(config, out).metrics.to_json()
         results.append({**metrics, "run": {"world": world, "scenario": scenario, "seed": seed}})
         print(row(world, scenario, seed, metrics), flush=True)
     city = [r for r in results if r["run"]["world"] == "city"]

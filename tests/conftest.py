@@ -3,12 +3,25 @@
 from __future__ import annotations
 
 import os
+import shutil
+from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
+import numpy as np
 import pytest
+from filelock import FileLock
+from numpy.typing import NDArray
 
-from seminspect.missions.config import make_config
-from seminspect.missions.run import MissionResult, run_mission
+from seminspect.core.io import read_versioned_json
+from seminspect.graphs.lsg.graph import LayeredSemanticGraph
+from seminspect.graphs.lsg.io import load_graph
+from seminspect.mapping.voxel import VoxelMap, load_map
+from seminspect.missions.config import ResolvedMissionConfig, make_config, resolve
+from seminspect.missions.metrics import MissionMetrics, QueryAnswer
+from seminspect.missions.run import run_mission
+from seminspect.missions.rundir import load_trajectory, read_run_config
+from seminspect.worlds import World, generate_world
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -107,13 +120,71 @@ def mission_queries() -> list[str]:
     return list(QUERIES)
 
 
-@pytest.fixture(scope="session")
-def small_mission(tmp_path_factory: pytest.TempPathFactory) -> MissionResult:
-    out = tmp_path_factory.mktemp("mission") / "campus-small"
-    config = make_config({"world": "campus", "scenario": "small", "seed": 0})
-    return run_mission(config, out, queries=QUERIES)
+@dataclass(frozen=True)
+class SavedRun:
+    """A finished run as its directory holds it: what the tests of the shared mission read."""
+
+    run_dir: Path
+    state: str
+    reason: str
+    config: ResolvedMissionConfig
+    metrics: MissionMetrics
+    graph: LayeredSemanticGraph
+    occupancy: VoxelMap
+    #: The robot's last odometry position.
+    final_position: NDArray[np.float64]
+
+    @property
+    def answers(self) -> list[QueryAnswer]:
+        return self.metrics.queries
+
+    @cached_property
+    def world(self) -> World:
+        """The run's world, generated again from its seed."""
+        return generate_world(self.config.world, self.config.scenario, seed=self.config.seed)
+
+    @classmethod
+    def read(cls, run_dir: Path) -> SavedRun:
+        status = read_versioned_json(run_dir / "status.json", "seminspect.run-status", [1])
+        metrics = read_versioned_json(run_dir / "metrics.json", "seminspect.run-metrics", [1])
+        return cls(
+            run_dir,
+            status["state"],
+            status["reason"],
+            resolve(make_config(read_run_config(run_dir))),
+            MissionMetrics.from_json(metrics),
+            load_graph(run_dir / "graph.json"),
+            load_map(run_dir / "map.npz"),
+            load_trajectory(run_dir)[-1, 5:8],
+        )
+
+
+def _completed(run_dir: Path) -> bool:
+    status = run_dir / "status.json"
+    if not status.exists():
+        return False
+    return read_versioned_json(status, "seminspect.run-status", [1])["state"] == "completed"
 
 
 @pytest.fixture(scope="session")
-def small_mission_dir(small_mission: MissionResult) -> Path:
-    return small_mission.run_dir
+def small_mission_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The shared small mission's run directory, run once per test session.
+
+    Under xdist every worker has its own temporary directory below one the session shares;
+    the first worker to take the lock runs the mission there, the others wait and read it.
+    """
+    root = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        root = root.parent
+    out = root / "shared-mission" / "campus-small"
+    with FileLock(str(root / "shared-mission.lock")):
+        if not _completed(out):
+            shutil.rmtree(out, ignore_errors=True)
+            config = make_config({"world": "campus", "scenario": "small", "seed": 0})
+            run_mission(config, out, queries=QUERIES)
+    return out
+
+
+@pytest.fixture(scope="session")
+def small_mission(small_mission_dir: Path) -> SavedRun:
+    return SavedRun.read(small_mission_dir)

@@ -5,7 +5,9 @@ from pathlib import Path
 
 import numpy as np
 
-from seminspect.missions.planning_study import (
+from seminspect.studies.planning.comparison import HierarchicalTiming, VolumetricResult
+from seminspect.studies.planning.scaling import ScalingPoint
+from seminspect.studies.planning.study import (
     RESOLUTIONS,
     MissionOutcome,
     PathCheck,
@@ -13,8 +15,6 @@ from seminspect.missions.planning_study import (
     QueryComparison,
     RunComparison,
 )
-from seminspect.planning.comparison import HierarchicalTiming, VolumetricResult
-from seminspect.planning.scaling import ScalingPoint
 
 
 def query(vp_s: float, hp_m: float = 110.0, refined_m: float = 100.0) -> QueryComparison:

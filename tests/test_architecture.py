@@ -23,7 +23,8 @@ RANKS: dict[str, int] = {
     "missions": 8,
     "learning": 8,
     "report": 9,
-    "cli": 10,
+    "studies": 10,
+    "cli": 11,
 }
 
 

@@ -5,6 +5,7 @@ import pytest
 from cli_runner import run
 
 
+@pytest.mark.slow
 def test_mission_runs_and_says_where_the_results_are(capsys, tmp_path: Path) -> None:
     out = tmp_path / "tunnel"
     code, text, _ = run(

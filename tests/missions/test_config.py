@@ -5,7 +5,6 @@ from seminspect.missions.config import (
     CITY_BUDGETS,
     DEFAULT_BUDGET_S,
     MissionConfig,
-    inspection_params,
     make_config,
     resolve,
     survey_headings,
@@ -29,7 +28,7 @@ def test_worlds_bring_their_papers_presets() -> None:
         "aerial",
         ("building",),
     )
-    assert inspection_params(collapsed).d_check_T == 8.0  # 000 Table 2
+    assert collapsed.params.d_check_T == 8.0  # 000 Table 2
 
 
 def test_explicit_settings_win_over_defaults() -> None:
@@ -56,3 +55,11 @@ def test_impossible_settings_give_one_line(values, message) -> None:
 def test_survey_covers_the_full_circle() -> None:
     assert survey_headings(69.4, 0.1) == 6  # 6 x 62.5 deg >= 360 deg
     assert survey_headings(86.0, 0.1) == 5
+
+
+def test_a_resolved_config_serialises_as_the_config_it_came_from() -> None:
+    raw = make_config({"world": "subterranean"})
+    resolved = resolve(raw)
+    assert list(resolved.model_dump()) == list(raw.model_dump())  # config.json keeps its keys
+    assert resolved.inspection.d_view == 1.3 and resolved.scenario is None
+    assert resolve(resolved) == resolved

@@ -93,6 +93,7 @@ def test_frame_segments_are_objects_and_ground_classes(world) -> None:
     assert "car" in labels and {"sidewalk", "asphalt"} <= set(labels)
 
 
+@pytest.mark.slow
 def test_mapping_fuses_many_views_per_point_and_records_its_source(world, mapped) -> None:
     run, progress = mapped
     assert progress[-1] == (run.frames, run.frames) and len(progress) == run.frames
@@ -113,6 +114,7 @@ def test_mapping_fuses_many_views_per_point_and_records_its_source(world, mapped
     assert set(run.seconds) == {"sensors", "segments", "fusion", "total"}
 
 
+@pytest.mark.slow
 def test_quality_on_the_small_world_meets_the_targets(world, mapped, fake_encoder) -> None:
     run, _ = mapped
     build = build_terrain_graph(run.cloud, PROMPTS, fake_encoder, calibration=CALIBRATION)
@@ -128,6 +130,7 @@ def test_quality_on_the_small_world_meets_the_targets(world, mapped, fake_encode
         assert places["all_connected"] and places["off_terrain"] == 0, places
 
 
+@pytest.mark.slow
 def test_mapping_is_deterministic(fake_encoder) -> None:
     from dataclasses import replace
 

@@ -3,7 +3,7 @@ import numpy as np
 from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.perception.detections import MAX_MASK_POINTS, detection_points, observe
 from seminspect.sensors import CameraModel, render
-from seminspect.sensors.detection import detect
+from seminspect.sensors.segmentation import detect
 from seminspect.worlds import generate_world
 
 

@@ -12,9 +12,9 @@ from hypothesis import strategies as st
 from lsg_strategies import climbing_graphs, layered_graphs
 from seminspect.core.errors import PlanningError
 from seminspect.geometry.transforms import yaw_from_quat
-from seminspect.graphs.lsg.convert import traversable_networkx
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.model import FeatureNode, PoseNode
+from seminspect.graphs.lsg.networkx_view import traversable_networkx
 from seminspect.graphs.lsg.synthetic import synthetic_graph
 from seminspect.perception.observation import Observation
 from seminspect.planning.hierarchical import HierarchicalPlanner

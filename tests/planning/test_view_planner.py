@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from seminspect.core.config import build
 from seminspect.core.errors import InvalidInputError, PlanningError
+from seminspect.core.validation import build
 from seminspect.planning.view_planner import (
     ViewConstraints,
     nearest_surface_point,

@@ -21,12 +21,12 @@ from pydantic import ValidationError
 
 from seminspect import __version__
 from seminspect.cli._common import err_console, labelled
-from seminspect.core.config import describe_validation_error
 from seminspect.core.errors import SeminspectError
 from seminspect.core.interrupts import Interrupted, as_interrupted, stop_on_signals
+from seminspect.core.validation import describe_validation_error
 
 #: Typer ships its own click; take its usage-error class from a public exception's ancestry.
-_USAGE_ERROR = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "UsageError")
+_USAGE_ERROR: Any = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "UsageError")
 
 #: (module under seminspect.cli, group name, one-line help)
 #: Group modules import heavy dependencies inside their commands so ``--help`` stays fast.

@@ -103,7 +103,7 @@ def app(
     result = _run_with_progress(config, out, query)
     if pictures and result.stop_signal != signal.SIGTERM:  # SIGTERM asks to stop now
         from seminspect.report.html import write_mission_report
-        from seminspect.report.mission import render_run
+        from seminspect.report.run_pictures import render_run
 
         render_run(result.run_dir)
         write_mission_report(result.run_dir)
@@ -199,17 +199,19 @@ def _export_bag(run_dir: Path, bag: Path) -> None:
 
 
 def _print_result(result) -> None:
-    metrics = result.metrics
-    t3, t6, mission = metrics["table3"], metrics["table6"], metrics["mission"]
     console.print(labelled(f"{result.state}:", "bold", result.reason))
+    metrics = result.metrics
+    if metrics is None:  # stopped while its outputs were written
+        console.print(f"results so far: {result.run_dir}")
+        return
+    t3, t6, mission = metrics.table3, metrics.table6, metrics.mission
     console.print(
-        f"targets detected {t3['detected_pct']:.0f}%, inspected {t3['inspected_pct']:.0f}% of "
-        f"detected; localisation RMSE {_m(t6['localisation_rmse_m'])}; "
-        f"{mission['sim_time_s']:.0f} s simulated in {mission['wall_time_s']:.0f} s"
+        f"targets detected {t3.detected_pct:.0f}%, inspected {t3.inspected_pct:.0f}% of "
+        f"detected; localisation RMSE {_m(t6.localisation_rmse_m)}; "
+        f"{mission.sim_time_s:.0f} s simulated in {mission.wall_time_s:.0f} s"
     )
     console.print(
-        f"3DLSG: {t3['unified'][0]} nodes, {t3['unified'][1]} edges "
-        f"(reconciled {t3['reconciled_pct']:.1f}%)"
+        f"3DLSG: {t3.unified[0]} nodes, {t3.unified[1]} edges (reconciled {t3.reconciled_pct:.1f}%)"
     )
     for answer in result.answers:
         outcome = "reached" if answer.reached else f"not reached ({answer.error or 'too far'})"

@@ -130,11 +130,13 @@ def _quality(build, cloud, fused, encoder) -> dict[str, Any]:
 
     if fused is not None:
         return _kitti_quality(build, fused, encoder)
-    return evaluate_on_world(build, source_world(cloud), encoder)
+    world = source_world(cloud)
+    assert world is not None, "the command checks for a source world before building"
+    return evaluate_on_world(build, world, encoder)
 
 
 def _write_outputs(out: Path, build, cloud, progress) -> None:
-    from seminspect.graphs.terrain.serialization import save_terrain_graph, write_graphml
+    from seminspect.graphs.terrain.io import save_terrain_graph, write_graphml
     from seminspect.report.terrain import (
         plot_classified_cloud,
         plot_gvd_stages,
@@ -260,8 +262,8 @@ def route(
     terrain: str | None = typer.Option(None, help="Terrain types allowed, comma-separated."),
 ) -> None:
     """Shortest route between two places over the chosen terrain types."""
+    from seminspect.graphs.terrain.io import load_terrain_graph
     from seminspect.graphs.terrain.navigation import shortest_route
-    from seminspect.graphs.terrain.serialization import load_terrain_graph
 
     scene = load_terrain_graph(graph_file)
     allowed = [t.strip() for t in terrain.split(",") if t.strip()] if terrain else None

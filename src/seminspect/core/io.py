@@ -97,7 +97,9 @@ def atomic_write_with(path: str | os.PathLike[str], write: Callable[[io.BytesIO]
 
 def save_npz_atomic(path: str | os.PathLike[str], **arrays: np.ndarray) -> Path:
     """``numpy.savez_compressed`` with an atomic rename."""
-    return atomic_write_with(path, lambda buf: np.savez_compressed(buf, **arrays))
+    # numpy's stub lets ``**arrays`` meet the ``allow_pickle: bool`` keyword
+    save = np.savez_compressed
+    return atomic_write_with(path, lambda buf: save(buf, **arrays))  # type: ignore[arg-type]
 
 
 def _json_default(value: Any) -> Any:

@@ -13,8 +13,8 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from seminspect.core.config import build
 from seminspect.core.names import unknown_name
+from seminspect.core.validation import build
 
 PresetName = Literal["urban-simulated", "urban-experimental", "collapsed-buildings"]
 

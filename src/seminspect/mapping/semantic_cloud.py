@@ -397,9 +397,11 @@ def cloud_from_arrays(source: Path, arrays: dict[str, NDArray]) -> SemanticCloud
     """Validate the arrays of a saved cloud into a :class:`SemanticCloud`."""
     version = arrays.get("version")
     # a whole-number scalar only: a string or float "version" is not one seminspect wrote
-    exact = version is not None and version.shape == () and version.dtype.kind in "iu"
+    if version is None:
+        raise FileFormatError(f"{source}: semantic cloud has no version")
+    exact = version.shape == () and version.dtype.kind in "iu"
     if not exact or int(version) != CLOUD_VERSION:
-        found = None if version is None else version.tolist()
+        found = version.tolist()
         raise FileFormatError(f"{source}: semantic cloud version {found!r} is not supported")
     missing = [key for key in ("points", "embeddings", "counts", "encoder") if key not in arrays]
     if missing:

@@ -220,7 +220,8 @@ def fuse_kitti_scans(
     names = label_table().names
     world, semantic, instance = [], [], []
     for k, (scan_path, label_path) in enumerate(scans):
-        scan = read_kitti_scan(scan_path, label_path)
+        points, _ = read_scan(scan_path)
+        semantic_ids, instance_ids = read_labels(label_path, points.shape[0])
         pose = np.eye(4)
         if poses is not None:
             frame = frame_number(scan_path)
@@ -230,11 +231,11 @@ def fuse_kitti_scans(
                 )
             pose = poses[frame]
         integrate_labelled_scan(
-            cloud, scan.points, scan.semantic, pose, names=names, encoder=encoder, radius=radius
+            cloud, points, semantic_ids, pose, names=names, encoder=encoder, radius=radius
         )
-        world.append(transform_points(pose, scan.points))
-        semantic.append(scan.semantic)
-        instance.append(scan.instance)
+        world.append(transform_points(pose, points))
+        semantic.append(semantic_ids)
+        instance.append(instance_ids)
         if on_scan:
             on_scan(k)
     return FusedScans(

@@ -11,8 +11,8 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from seminspect.core.config import build
 from seminspect.core.params import PRESETS, InspectionParams, PresetName
+from seminspect.core.validation import build
 from seminspect.core.vocabulary import BUILDING_FEATURES, VEHICLE_PARTS
 
 Mode = Literal["ground", "aerial"]
@@ -112,6 +112,26 @@ class MissionConfig(_Strict):
     exploration: ExplorationConfig = ExplorationConfig()
 
 
+class ResolvedMissionConfig(MissionConfig):
+    """A :class:`MissionConfig` with every world default filled in (made by :func:`resolve`).
+
+    The same fields, serialised the same way; only the types promise that nothing is ``None``
+    any more, so code that runs a mission never checks.
+    """
+
+    preset: PresetName
+    mode: Mode
+    time_budget_s: float = Field(gt=0, description="simulated seconds")
+    target_classes: tuple[str, ...]
+    feature_labels: tuple[str, ...]
+    inspection: InspectionConfig
+
+    @property
+    def params(self) -> InspectionParams:
+        """The Table 1/2 parameters of the preset."""
+        return PRESETS[self.preset]
+
+
 #: 000 Sec VII-D: time limits of 700, 1400 and 2800 s for the 5, 10 and 20-vehicle scenarios,
 #: the paper's average completion times on its layout. Our city scatters its vehicles over the
 #: whole site, and complete missions take longer (city small: 1,030-1,180 s over seeds 0-2), so
@@ -144,13 +164,14 @@ def make_config(values: dict[str, Any]) -> MissionConfig:
     return build(MissionConfig, values, "mission setting")
 
 
-def resolve(config: MissionConfig) -> MissionConfig:
+def resolve(config: MissionConfig) -> ResolvedMissionConfig:
     """Fill every ``None`` field with the world's default."""
     defaults = WORLD_DEFAULTS.get(config.world, USER_WORLD_DEFAULTS)
     budget = defaults["budget"]
     inspection = config.inspection or InspectionConfig(d_view=defaults["d_view"])
-    return config.model_copy(
-        update={
+    return ResolvedMissionConfig.model_validate(
+        dict(config)
+        | {
             "scenario": config.scenario or defaults.get("scenario"),
             "preset": config.preset or defaults["preset"],
             "mode": config.mode or defaults["mode"],
@@ -160,11 +181,6 @@ def resolve(config: MissionConfig) -> MissionConfig:
             "inspection": inspection,
         }
     )
-
-
-def inspection_params(config: MissionConfig) -> InspectionParams:
-    """The Table 1/2 parameters of a resolved configuration."""
-    return PRESETS[config.preset or "urban-simulated"]
 
 
 def survey_headings(fov_deg: float, overlap: float) -> int:

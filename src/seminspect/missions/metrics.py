@@ -1,4 +1,5 @@
-"""Mission measurements: where wall time goes, CPU load and inspection coverage (000 Table 6).
+"""Mission measurements and the run's figures: where wall time goes, CPU load, inspection
+coverage (000 Table 6), and :class:`MissionMetrics`, the typed form of ``metrics.json``.
 
 **Inspection coverage** is measured two ways:
 
@@ -16,12 +17,14 @@ import time
 from collections import defaultdict
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
+from typing import Any
 
 import numpy as np
 import psutil
 from numpy.typing import NDArray
 
+from seminspect.missions.evaluation import Match
 from seminspect.sensors import Frame
 from seminspect.worlds import World
 
@@ -112,3 +115,135 @@ class CoverageRecorder:
             return 0.0
         seen = np.isin(outward, np.fromiter(self.targets[target_id].faces, dtype=np.int64))
         return float(areas[seen].sum() / areas.sum())
+
+
+@dataclass
+class LevelEndings:
+    """How many levels ended by scene similarity (eq 8) and by the safety cap."""
+
+    similarity: int = 0
+    cap: int = 0
+
+
+@dataclass(frozen=True)
+class QueryAnswer:
+    """An operator query answered after the mission and driven by the robot."""
+
+    query: str
+    goal: str | None
+    planning_time_s: float | None
+    path_length_m: float | None
+    reached: bool
+    final_distance_m: float | None
+    error: str | None = None
+
+
+@dataclass(frozen=True)
+class RunIdentity:
+    """Which world, scenario and seed a run explored."""
+
+    name: str
+    scenario: str | None
+    seed: int
+
+
+@dataclass(frozen=True)
+class GraphFigures:
+    """000 Table 3's columns: ``[nodes, edges]`` per layer, reconciliation, detection."""
+
+    target: tuple[int, int]
+    level: tuple[int, int]
+    pose: tuple[int, int]
+    feature: tuple[int, int]
+    total: tuple[int, int]
+    unified: tuple[int, int]
+    reconciled_pct: float
+    detected_pct: float
+    inspected_pct: float
+    avg_planning_time_ms: float | None
+
+
+@dataclass(frozen=True)
+class QualityFigures:
+    """000 Table 6's columns: load, localisation error and inspection coverage."""
+
+    cpu_load_pct: float
+    planning_load_pct: float | None
+    localisation_rmse_m: float | None
+    localisation_rmse_3d_m: float | None
+    surface_coverage_pct: float | None
+    bbox_volume_m3: float
+    true_bbox_volume_m3: float
+    bbox_volume_ratio: float | None
+
+
+@dataclass(frozen=True)
+class TargetFigures:
+    """The Target layer scored against the world's true objects."""
+
+    true: int
+    in_graph: int
+    matched: int
+    inspected: int
+    false_targets: int
+    unreachable: list[str]
+    matches: list[Match]
+
+
+@dataclass(frozen=True)
+class MissionFigures:
+    """The mission's own figures: time, distance, sensing, levels and planning."""
+
+    sim_time_s: float
+    wall_time_s: float
+    real_time_factor: float | None
+    distance_m: float
+    frames: int
+    lidar_scans: int
+    collisions: int
+    level_endings: LevelEndings
+    hierarchical_queries: int
+    local_plans: int
+    local_planning_ms_mean: float | None
+    planning_wall_s: float
+    planning_time_charged: bool
+    wall_time_by_category_s: dict[str, float]
+
+
+@dataclass(frozen=True)
+class MissionMetrics:
+    """Every figure of a run, as ``metrics.json`` holds them (:meth:`to_json`)."""
+
+    state: str
+    stop_reason: str
+    world: RunIdentity
+    table3: GraphFigures
+    table6: QualityFigures
+    targets: TargetFigures
+    mission: MissionFigures
+    queries: list[QueryAnswer]
+
+    def to_json(self) -> dict[str, Any]:
+        """The ``metrics.json`` content: nested dicts under the field names."""
+        return asdict(self)
+
+    @classmethod
+    def from_json(cls, data: dict[str, Any]) -> MissionMetrics:
+        """Read back what :meth:`to_json` wrote."""
+        t3 = dict(data["table3"])
+        for layer in ("target", "level", "pose", "feature", "total", "unified"):
+            t3[layer] = tuple(t3[layer])
+        targets = dict(data["targets"])
+        targets["matches"] = [Match(**m) for m in targets["matches"]]
+        mission = dict(data["mission"])
+        mission["level_endings"] = LevelEndings(**mission["level_endings"])
+        return cls(
+            data["state"],
+            data["stop_reason"],
+            RunIdentity(**data["world"]),
+            GraphFigures(**t3),
+            QualityFigures(**data["table6"]),
+            TargetFigures(**targets),
+            MissionFigures(**mission),
+            [QueryAnswer(**q) for q in data["queries"]],
+        )

@@ -23,8 +23,8 @@ from seminspect.geometry.transforms import as_point, wrap_angle
 from seminspect.robot import Robot
 from seminspect.robot.robot import MoveResult
 from seminspect.sensors import CameraModel, Detection, Frame, Lidar, LidarScan, render
-from seminspect.sensors.detection import detect
 from seminspect.sensors.noise import NoiseModel, make_noise
+from seminspect.sensors.segmentation import detect
 from seminspect.worlds import World
 
 
@@ -43,7 +43,7 @@ class Motion:
 
 
 class Platform(Protocol):
-    """What the mission needs of a robot."""
+    """What the mission needs of a robot: everything the executive and the run's metrics read."""
 
     @property
     def time(self) -> float: ...
@@ -56,6 +56,30 @@ class Platform(Protocol):
 
     @property
     def distance_travelled(self) -> float: ...
+
+    @property
+    def camera_pitch(self) -> float:
+        """The camera's tilt below the horizon [rad]."""
+        ...
+
+    @property
+    def frames(self) -> int:
+        """Camera frames taken so far."""
+        ...
+
+    @property
+    def scans(self) -> int:
+        """LiDAR scans taken so far."""
+        ...
+
+    @property
+    def blocked_moves(self) -> int:
+        """Motions stopped by an obstacle so far."""
+        ...
+
+    def trajectory_rows(self) -> NDArray[np.float64]:
+        """``(n, 9)`` rows: time, position (3), yaw, odometry position (3), odometry yaw."""
+        ...
 
     def move_to(self, point: ArrayLike, yaw: float | None = None) -> Motion: ...
 
@@ -138,6 +162,18 @@ class SimulatedPlatform:
     @property
     def distance_travelled(self) -> float:
         return self.robot.distance_travelled
+
+    def trajectory_rows(self) -> NDArray[np.float64]:
+        trajectory = self.robot.trajectory
+        return np.column_stack(
+            [
+                trajectory.time,
+                trajectory.position,
+                trajectory.yaw,
+                trajectory.odometry_position,
+                trajectory.odometry_yaw,
+            ]
+        )
 
     # ----------------------------------------------------------------- motion
     def _to_true(self, point: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -20,9 +20,9 @@ import numpy as np
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from seminspect.core.config import describe_validation_error
 from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.core.io import read_json
+from seminspect.core.validation import describe_validation_error
 from seminspect.planning.global_views import InspectionRegion
 from seminspect.worlds.routine_sites import SitePair
 

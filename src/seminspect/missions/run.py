@@ -13,42 +13,37 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from seminspect.core.errors import SeminspectError
 from seminspect.core.interrupts import stop_on_signals
 from seminspect.mapping.voxel import VoxelMap
-from seminspect.missions.config import MissionConfig, inspection_params, resolve
+from seminspect.missions.config import MissionConfig, ResolvedMissionConfig, resolve
 from seminspect.missions.evaluation import (
     DEFAULT_GATE_M,
     TargetScore,
     TruthTarget,
     score_targets,
 )
-from seminspect.missions.metrics import CpuMeter
+from seminspect.missions.metrics import (
+    CpuMeter,
+    GraphFigures,
+    MissionFigures,
+    MissionMetrics,
+    QualityFigures,
+    QueryAnswer,
+    RunIdentity,
+    TargetFigures,
+)
 from seminspect.missions.platform import SimulatedPlatform, mission_noise
-from seminspect.missions.report import summary_markdown
 from seminspect.missions.rundir import OUTPUT_FILES, RunDirectory, RunEnd, conduct_run
+from seminspect.missions.summary import summary_markdown
 from seminspect.missions.xflie import MissionProgress, XFlie
 from seminspect.worlds import World, open_world
 from seminspect.worlds.catalog import is_world_path
-
-
-@dataclass
-class QueryAnswer:
-    """An operator query answered after the mission and driven by the robot."""
-
-    query: str
-    goal: str | None
-    planning_time_s: float | None
-    path_length_m: float | None
-    reached: bool
-    final_distance_m: float | None
-    error: str | None = None
 
 
 @dataclass
@@ -58,7 +53,7 @@ class MissionResult:
     run_dir: Path
     state: str
     reason: str
-    metrics: dict[str, Any]
+    metrics: MissionMetrics | None  # None when stopped before they could be computed
     mission: XFlie
     world: World
     answers: list[QueryAnswer] = field(default_factory=list)
@@ -73,21 +68,21 @@ def run_name(config: MissionConfig) -> str:
 
 
 def build_mission(
-    config: MissionConfig,
+    config: ResolvedMissionConfig,
     run: RunDirectory | None,
     progress: Callable[[MissionProgress], None] | None = None,
     world: World | None = None,
 ) -> tuple[XFlie, World]:
     """The world (made from ``config`` unless given), the robot in it and the executive."""
     world = world or open_world(config.world, config.scenario, seed=config.seed)
-    params = inspection_params(config)
+    params = config.params
     # Ground robots carry the camera at body height; aerial ones start at Level-0's height.
     aerial = config.mode == "aerial"
     start_height = config.robot.flight_height if aerial else config.robot.body_height
     platform = SimulatedPlatform(
         world,
         params,
-        mode=config.mode or "ground",
+        mode=config.mode,
         noise=mission_noise(config.noise, config.odometry_drift_per_m),
         seed=config.seed,
         radius=config.robot.radius,
@@ -133,7 +128,7 @@ def run_mission(
 
 def _run(
     run: RunDirectory,
-    config: MissionConfig,
+    config: ResolvedMissionConfig,
     world: World,
     queries: Sequence[str],
     progress: Callable[[MissionProgress], None] | None,
@@ -141,7 +136,7 @@ def _run(
     mission, world = build_mission(config, run, progress, world)
     cpu = CpuMeter()
     answers: list[QueryAnswer] = []
-    metrics: dict[str, Any] = {}
+    metrics: MissionMetrics | None = None
 
     def write_outputs(end: RunEnd) -> None:
         nonlocal answers, metrics
@@ -182,7 +177,7 @@ def answer_queries(mission: XFlie, queries: Sequence[str]) -> list[QueryAnswer]:
                 text, plan.goal_id, plan.timing.total_s, plan.length, distance <= epsilon, distance
             )
         )
-        mission.record_plan(plan.goal_id, plan)
+        mission.recorder.plan(plan.goal_id, plan)
     return answers
 
 
@@ -202,66 +197,99 @@ def mission_metrics(
     state: str,
     reason: str,
     answers: Sequence[QueryAnswer],
-) -> dict[str, Any]:
+) -> MissionMetrics:
     """Every figure of a run: 000 Table 3 and Table 6 columns, and the mission's own."""
     config = mission.config
-    truths = truth_targets(world, config.target_classes or ())
+    truths = truth_targets(world, config.target_classes)
     # The graph merges detections within d_check^T; score on the same terms (8 m for buildings).
     gate = max(DEFAULT_GATE_M, mission.params.d_check_T)
     score = score_targets(mission.graph.targets(), truths, gate=gate)
+    record = mission.recorder.record()
+    return MissionMetrics(
+        state,
+        reason,
+        RunIdentity(config.world, config.scenario, config.seed),
+        graph_figures(mission, score, [r.seconds for r in record.plans]),
+        quality_figures(mission, world, cpu, score),
+        TargetFigures(
+            score.truths,
+            score.targets,
+            len(score.matches),
+            sum(m.inspected for m in score.matches),
+            score.false_targets,
+            sorted(mission.unreachable),
+            list(score.matches),
+        ),
+        mission_figures(mission, cpu),
+        list(answers),
+    )
+
+
+def graph_figures(mission: XFlie, score: TargetScore, planning: list[float]) -> GraphFigures:
+    """000 Table 3's columns for the mission's graph."""
     stats = mission.graph.population()
-    planning = [r.seconds for r in mission.hierarchical]
-    local = mission.navigator.stats.local_planning_s
-    return {
-        "state": state,
-        "stop_reason": reason,
-        "world": {"name": config.world, "scenario": config.scenario, "seed": config.seed},
-        "table3": {
-            "target": [stats.target.nodes, stats.target.edges],
-            "level": [stats.level.nodes, stats.level.edges],
-            "pose": [stats.pose.nodes, stats.pose.edges],
-            "feature": [stats.feature.nodes, stats.feature.edges],
-            "total": [stats.total.nodes, stats.total.edges],
-            "unified": [stats.unified.nodes, stats.unified.edges],
-            "reconciled_pct": stats.reconciled_pct,
-            "detected_pct": score.detected_pct,
-            "inspected_pct": score.inspected_pct,
-            "avg_planning_time_ms": 1e3 * float(np.mean(planning)) if planning else None,
-        },
-        "table6": {
-            "cpu_load_pct": cpu.load_pct(),
-            "planning_load_pct": planning_load_pct(mission),
-            "localisation_rmse_m": _finite(score.rmse(horizontal=True)),
-            "localisation_rmse_3d_m": _finite(score.rmse(horizontal=False)),
-            **coverage_metrics(mission, world, score),
-        },
-        "targets": {
-            "true": score.truths,
-            "in_graph": score.targets,
-            "matched": len(score.matches),
-            "inspected": sum(m.inspected for m in score.matches),
-            "false_targets": score.false_targets,
-            "unreachable": sorted(mission.unreachable),
-            "matches": [asdict(m) for m in score.matches],
-        },
-        "mission": {
-            "sim_time_s": mission.platform.time,
-            "wall_time_s": cpu.wall_s,
-            "real_time_factor": mission.platform.time / cpu.wall_s if cpu.wall_s > 0 else None,
-            "distance_m": mission.platform.distance_travelled,
-            "frames": mission.platform.frames,
-            "lidar_scans": mission.platform.scans,
-            "collisions": mission.platform.blocked_moves,
-            "level_endings": mission.level_endings,
-            "hierarchical_queries": len(planning),
-            "local_plans": mission.navigator.stats.local_plans,
-            "local_planning_ms_mean": 1e3 * float(np.mean(local)) if local else None,
-            "planning_wall_s": mission.navigator.stats.planning_s,
-            "planning_time_charged": config.charge_planning_time,
-            "wall_time_by_category_s": {k: round(v, 3) for k, v in mission.timers.seconds.items()},
-        },
-        "queries": [asdict(a) for a in answers],
-    }
+    return GraphFigures(
+        (stats.target.nodes, stats.target.edges),
+        (stats.level.nodes, stats.level.edges),
+        (stats.pose.nodes, stats.pose.edges),
+        (stats.feature.nodes, stats.feature.edges),
+        (stats.total.nodes, stats.total.edges),
+        (stats.unified.nodes, stats.unified.edges),
+        stats.reconciled_pct,
+        score.detected_pct,
+        score.inspected_pct,
+        1e3 * float(np.mean(planning)) if planning else None,
+    )
+
+
+def quality_figures(
+    mission: XFlie, world: World, cpu: CpuMeter, score: TargetScore
+) -> QualityFigures:
+    """000 Table 6's columns: load, localisation error, and coverage over inspected targets
+    (surface coverage and the paper's bounding-box volume)."""
+    by_name = {info.name: info for info in world.instances.values()}
+    coverage = mission.recorder.coverage
+    surface, box, truth_box = [], 0.0, 0.0
+    for match in score.matches:
+        if not match.inspected:
+            continue
+        info = by_name[match.truth]
+        surface.append(coverage.surface_coverage(match.target_id, world, info.id))
+        box += coverage.targets[match.target_id].box_volume
+        truth_box += float(np.prod(info.bbox_max - info.bbox_min))
+    return QualityFigures(
+        cpu.load_pct(),
+        planning_load_pct(mission),
+        _finite(score.rmse(horizontal=True)),
+        _finite(score.rmse(horizontal=False)),
+        100.0 * float(np.mean(surface)) if surface else None,
+        box,
+        truth_box,
+        box / truth_box if truth_box else None,
+    )
+
+
+def mission_figures(mission: XFlie, cpu: CpuMeter) -> MissionFigures:
+    """Time, distance, sensing, level endings and planning of the mission."""
+    platform, stats = mission.platform, mission.navigator.stats
+    record = mission.recorder.record()
+    local = stats.local_planning_s
+    return MissionFigures(
+        platform.time,
+        cpu.wall_s,
+        platform.time / cpu.wall_s if cpu.wall_s > 0 else None,
+        platform.distance_travelled,
+        platform.frames,
+        platform.scans,
+        platform.blocked_moves,
+        record.level_endings,
+        len(record.plans),
+        stats.local_plans,
+        1e3 * float(np.mean(local)) if local else None,
+        stats.planning_s,
+        mission.config.charge_planning_time,
+        {k: round(v, 3) for k, v in record.seconds_by_category.items()},
+    )
 
 
 def planning_load_pct(mission: XFlie) -> float | None:
@@ -271,46 +299,18 @@ def planning_load_pct(mission: XFlie) -> float | None:
     return 100.0 * mission.navigator.stats.planning_s / sim_time if sim_time > 0 else None
 
 
-def coverage_metrics(mission: XFlie, world: World, score: TargetScore) -> dict[str, Any]:
-    """Surface coverage and the paper's bounding-box volume, over inspected targets."""
-    by_name = {info.name: info for info in world.instances.values()}
-    surface, box, truth_box = [], 0.0, 0.0
-    for match in score.matches:
-        if not match.inspected:
-            continue
-        info = by_name[match.truth]
-        surface.append(mission.coverage.surface_coverage(match.target_id, world, info.id))
-        box += mission.coverage.targets[match.target_id].box_volume
-        truth_box += float(np.prod(info.bbox_max - info.bbox_min))
-    return {
-        "surface_coverage_pct": 100.0 * float(np.mean(surface)) if surface else None,
-        "bbox_volume_m3": box,
-        "true_bbox_volume_m3": truth_box,
-        "bbox_volume_ratio": box / truth_box if truth_box else None,
-    }
-
-
 def _finite(value: float) -> float | None:
     return value if math.isfinite(value) else None
 
 
 def _write_outputs(
-    run: RunDirectory, mission: XFlie, metrics: dict[str, Any], answers: Sequence[QueryAnswer]
+    run: RunDirectory, mission: XFlie, metrics: MissionMetrics, answers: Sequence[QueryAnswer]
 ) -> None:
     run.write_graph(mission.graph)
     run.write_map(mission.occupancy)
-    trajectory = mission.platform.robot.trajectory if hasattr(mission.platform, "robot") else None
-    if trajectory is not None:
-        rows = np.column_stack(
-            [
-                trajectory.time,
-                trajectory.position,
-                trajectory.yaw,
-                trajectory.odometry_position,
-                trajectory.odometry_yaw,
-            ]
-        )
-        run.write_trajectory(rows.tolist())
+    run.write_trajectory(mission.platform.trajectory_rows().tolist())
     run.flush_events()
     run.write_summary(summary_markdown(metrics, mission.graph, answers))
-    run.write_metrics(metrics)  # last: its presence says every output before it was written
+    run.write_metrics(
+        metrics.to_json()
+    )  # last: its presence says every output before it was written

@@ -61,6 +61,7 @@ from seminspect.core.provenance import code_differences, code_version
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.io import save_graph
 from seminspect.mapping.voxel import VoxelMap, save_map
+from seminspect.missions.metrics import MissionMetrics
 from seminspect.worlds import World, open_world
 
 if TYPE_CHECKING:
@@ -405,9 +406,11 @@ def read_run_config(run_dir: Path) -> dict[str, Any]:
     return read_versioned_json(run_dir / "config.json", CONFIG_FORMAT, [1])["config"]
 
 
-def read_run_metrics(run_dir: Path) -> dict[str, Any]:
+def read_run_metrics(run_dir: Path) -> MissionMetrics:
     """The metrics a run wrote when it ended."""
-    return read_versioned_json(run_dir / "metrics.json", METRICS_FORMAT, [1])
+    return MissionMetrics.from_json(
+        read_versioned_json(run_dir / "metrics.json", METRICS_FORMAT, [1])
+    )
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import shapely
@@ -36,8 +36,8 @@ from pydantic import BaseModel, ConfigDict, Field
 from scipy import ndimage
 from shapely.geometry import Polygon
 
-from seminspect.core.config import build
 from seminspect.core.errors import InvalidInputError, PlanningError
+from seminspect.core.validation import build
 from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.graphs.terrain.evaluate import (
     closest_class,
@@ -290,7 +290,8 @@ class _Fusion:
             depth_tolerance_per_m=params.depth_tolerance_per_m,
         )
         t2 = time.perf_counter()
-        in_lidar = transform_points(np.linalg.inv(T_world_lidar), scan.points)
+        lidar_from_world = cast("NDArray[np.float64]", np.linalg.inv(T_world_lidar))
+        in_lidar = transform_points(lidar_from_world, scan.points)
         stats = fuse_scan(self.cloud, in_lidar, T_world_lidar, segmentation, radius=params.radius)
         self.fused += stats.associated + stats.added
         self.seconds["sensors"] += t1 - t0
@@ -333,20 +334,22 @@ def evaluate_on_world(
     for prompt in scene.prompts.terrain:
         truth = closest_class(encoder, prompt, terrain_classes, scene.calibration.terrain)
         mine = [polygon for cls, polygon in patches if cls == truth]
-        scores = score_places(
+        place_scores = score_places(
             scene, prompt, mine, min_area=min_patch_area, tolerance=scene.params.cell_size
         )
         places[prompt] = {
             "ground_truth_class": truth,
             "points_on_terrain": _points_on(scene.layer1, prompt, mine),
-            **scores.as_dict(),
+            **place_scores.as_dict(),
         }
     return {"objects": objects, "places": places}
 
 
 def _points_on(layer: TaskPoints | None, prompt: str, patches: list[Polygon]) -> float | None:
     """Share of a terrain prompt's layer-1 points that lie on a true patch of its class."""
-    rows = layer.of(prompt) if layer is not None else np.zeros(0, np.int64)
+    if layer is None:
+        return None
+    rows = layer.of(prompt)
     if rows.size == 0:
         return None
     if not patches:

@@ -48,8 +48,11 @@ class Segment:
 class TextEncoder(Protocol):
     """Embeds text; ``encode_text`` returns ``(n, dim)`` float32 rows of unit length."""
 
-    name: str
-    dim: int
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def dim(self) -> int: ...
 
     def encode_text(self, texts: Sequence[str]) -> Embeddings: ...
 

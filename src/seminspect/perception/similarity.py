@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import cast
 
 import cv2
 import numpy as np
@@ -61,7 +62,7 @@ class SceneMatcher:
     def __post_init__(self) -> None:
         if self.max_features < 8 or not 0 < self.ratio < 1 or self.ransac_px <= 0:
             raise InvalidInputError("matcher needs max_features >= 8, 0 < ratio < 1, ransac_px > 0")
-        self._orb = cv2.ORB_create(nfeatures=self.max_features)
+        self._orb = cv2.ORB_create(nfeatures=self.max_features)  # type: ignore[attr-defined]
         self._matcher = cv2.BFMatcher(cv2.NORM_HAMMING)
 
     def features(self, image: NDArray[np.uint8]) -> ImageFeatures:
@@ -69,7 +70,7 @@ class SceneMatcher:
         grey = _grey(image)
         keypoints, descriptors = self._orb.detectAndCompute(grey, None)
         points = np.array([k.pt for k in keypoints], dtype=np.float32).reshape(-1, 2)
-        return ImageFeatures(points, descriptors)
+        return ImageFeatures(points, cast("NDArray[np.uint8] | None", descriptors))
 
     def matches(self, query: ImageFeatures, candidate: ImageFeatures) -> int:
         """``|M(I_q, i)|``: ratio-test matches that also agree on one homography."""
@@ -103,4 +104,8 @@ def scene_similarity(
 def _grey(image: NDArray[np.uint8]) -> NDArray[np.uint8]:
     if image.dtype != np.uint8 or image.ndim not in (2, 3):
         raise InvalidInputError("images must be uint8 arrays of shape (H, W) or (H, W, 3)")
-    return image if image.ndim == 2 else cv2.cvtColor(image, cv2.COLOR_RGB2GRAY)
+    return (
+        image
+        if image.ndim == 2
+        else cast("NDArray[np.uint8]", cv2.cvtColor(image, cv2.COLOR_RGB2GRAY))
+    )

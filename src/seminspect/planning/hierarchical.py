@@ -42,8 +42,8 @@ from seminspect.graphs.lsg.model import (
     TargetNode,
     TargetStatus,
 )
+from seminspect.planning.graph_search import CsrGraph, shortest_path, warm_up
 from seminspect.planning.query import Query, Verb, parse_query, resolve_query
-from seminspect.planning.search import CsrGraph, shortest_path, warm_up
 
 
 @dataclass(frozen=True, slots=True)

@@ -36,12 +36,12 @@ from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.io import FORMAT as LSG_FORMAT
 from seminspect.graphs.lsg.io import load_graph
 from seminspect.graphs.lsg.model import EdgeKind, FeatureNode, Layer, Node, RobotNode, TargetNode
+from seminspect.graphs.terrain.io import GRAPH_FORMAT as TERRAIN_FORMAT
+from seminspect.graphs.terrain.io import load_terrain_graph
 from seminspect.graphs.terrain.scene_graph import TerrainSceneGraph
-from seminspect.graphs.terrain.serialization import GRAPH_FORMAT as TERRAIN_FORMAT
-from seminspect.graphs.terrain.serialization import load_terrain_graph
 from seminspect.missions.rundir import load_run_world, load_trajectory, read_run_metrics
 from seminspect.report.lsg import LAYER_ORDER, layer_heights, lifted_position
-from seminspect.report.mission import load_events, utility_series
+from seminspect.report.run_pictures import load_events, utility_series
 from seminspect.report.terrain import layer_lifts, prompt_colours, subsample_rows
 from seminspect.worlds import World
 
@@ -222,7 +222,7 @@ def path_plot(trajectory: NDArray):
 
 def _metrics_sections(root: Path) -> list[Section]:
     try:
-        metrics = read_run_metrics(root)
+        metrics = read_run_metrics(root).to_json()
     except FileFormatError:
         return [Section("Summary", "<p>This run wrote no metrics (it may have been stopped).</p>")]
     state = f"<p>State: <b>{html.escape(str(metrics.get('state')))}</b> "

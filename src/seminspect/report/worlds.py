@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Literal
+from typing import Literal, cast
 
 import matplotlib
 
@@ -21,6 +21,7 @@ from matplotlib.axes import Axes
 from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
+from mpl_toolkits.mplot3d import Axes3D
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 from numpy.typing import NDArray
 
@@ -75,11 +76,13 @@ def draw_top_down(world: World, ax: Axes) -> None:
     keep = order[up[order]]
     colours = _face_colours(world)[keep]
     ax.add_collection(
-        PolyCollection(tris[keep, :, :2], facecolors=colours, edgecolors=colours, linewidths=0.2)
+        PolyCollection(
+            list(tris[keep, :, :2]), facecolors=colours, edgecolors=colours, linewidths=0.2
+        )
     )
     for info in world.instances.values():
         if info.class_name != "building" or len(world.instances) < 40:
-            ax.annotate(info.name, info.centroid[:2], fontsize=6, ha="center", va="center")
+            ax.annotate(info.name, tuple(info.centroid[:2]), fontsize=6, ha="center", va="center")
     if world.metadata.get("drive_path"):
         path = np.asarray(world.metadata["drive_path"], dtype=np.float64)
         ax.plot(path[:, 0], path[:, 1], "--", color="crimson", linewidth=0.8, label="drive path")
@@ -95,7 +98,7 @@ def draw_top_down(world: World, ax: Axes) -> None:
     ax.legend(loc="upper right", fontsize=7)
 
 
-def draw_3d(world: World, ax: Axes, elevation: float = 35.0, azimuth: float = -60.0) -> None:
+def draw_3d(world: World, ax: Axes3D, elevation: float = 35.0, azimuth: float = -60.0) -> None:
     """Faces seen from (elevation, azimuth) degrees, back faces culled, Lambert-shaded."""
     el, az = np.radians(elevation), np.radians(azimuth)
     towards_viewer = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
@@ -114,7 +117,7 @@ def draw_3d(world: World, ax: Axes, elevation: float = 35.0, azimuth: float = -6
     ax.set_xlim(lo[0], hi[0])
     ax.set_ylim(lo[1], hi[1])
     ax.set_zlim(lo[2], hi[2])
-    ax.set_box_aspect(tuple(hi - lo))
+    ax.set_box_aspect((hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]))
     ax.zaxis.set_major_locator(MaxNLocator(nbins=3))  # flat worlds leave little room for ticks
     ax.view_init(elev=elevation, azim=azimuth)
     ax.set_xlabel("x [m]")
@@ -131,7 +134,7 @@ def world_figure(world: World, view: View = "both") -> Figure:
         if name == "top":
             draw_top_down(world, fig.add_subplot(1, len(views), i))
         else:
-            draw_3d(world, fig.add_subplot(1, len(views), i, projection="3d"))
+            draw_3d(world, cast(Axes3D, fig.add_subplot(1, len(views), i, projection="3d")))
     scenario = world.metadata.get("scenario")
     title = f"{world.name}" + (f" ({scenario})" if scenario else "") + f", seed {world.seed}"
     fig.suptitle(title)

@@ -1,9 +1,9 @@
 """Simulated sensors: ray-cast depth + segmentation camera, intensity image, LiDAR, noise models."""
 
 from seminspect.sensors.camera import CameraModel, Frame, render
-from seminspect.sensors.detection import Detection, detect, detect_instances, detect_parts
 from seminspect.sensors.lidar import Lidar, LidarScan
 from seminspect.sensors.noise import NoiseModel, make_noise, noise_preset, require_rng
+from seminspect.sensors.segmentation import Detection, detect, detect_instances, detect_parts
 
 __all__ = [
     "CameraModel",

@@ -125,8 +125,8 @@ class Frame:
     orientation: Quat
     stamp: float
     camera: CameraModel
-    odometry_position: Vec3 = field(default=None)  # type: ignore[assignment]
-    odometry_orientation: Quat = field(default=None)  # type: ignore[assignment]
+    odometry_position: Vec3 = field(default=None)  # type: ignore[arg-type]
+    odometry_orientation: Quat = field(default=None)  # type: ignore[arg-type]
 
     def __post_init__(self) -> None:
         if self.odometry_position is None:
@@ -231,8 +231,10 @@ def render(
         orientation=quat,
         stamp=float(stamp),
         camera=model,
-        odometry_position=None if odometry is None else as_point(odometry[0], "odometry position"),
-        odometry_orientation=None
+        odometry_position=origin
+        if odometry is None
+        else as_point(odometry[0], "odometry position"),
+        odometry_orientation=quat
         if odometry is None
         else as_quaternion(odometry[1], "odometry orientation"),
     )

@@ -87,7 +87,8 @@ def _solid_cells(
     shape: tuple[int, ...],
 ) -> NDArray[np.bool_]:
     """Cells touching a triangle, plus the enclosed inside of every object (instance > 0)."""
-    occupied = cells_touching_triangles(triangles[face_instance == 0], origin, cell, shape)
+    nx, ny, nz = shape  # a 3D grid
+    occupied = cells_touching_triangles(triangles[face_instance == 0], origin, cell, (nx, ny, nz))
     order = np.argsort(face_instance, kind="stable")
     ids, starts = np.unique(face_instance[order], return_index=True)
     for inst, lo, hi in zip(ids, starts, np.append(starts[1:], len(order)), strict=True):

@@ -100,7 +100,7 @@ def box(lower: ArrayLike, upper: ArrayLike, label: str = "", **sides: str) -> Pi
         raise InvalidInputError(f"unknown box sides {sorted(unknown)}")
     (x0, y0, z0), (x1, y1, z1) = np.asarray(lower, float), np.asarray(upper, float)
     if not (x1 > x0 and y1 > y0 and z1 > z0):
-        raise InvalidInputError(f"empty box {lower} - {upper}")
+        raise InvalidInputError(f"empty box {lower!s} - {upper!s}")
     edge = [sides.get(k, label) for k in ("bottom", "front", "top", "back")]
     return prism_xz(
         [(x0, z0), (x1, z0), (x1, z1), (x0, z1)],

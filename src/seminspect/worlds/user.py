@@ -173,6 +173,7 @@ def _trimesh_mesh(path: Path) -> tuple[NDArray, NDArray, list[str], NDArray]:
         raise FileFormatError(f"{path}: cannot read mesh ({type(exc).__name__}: {exc})") from None
     vertices, faces, group_of, groups = [], [], [], []
     offset = 0
+    assert isinstance(scene, trimesh.Scene), "force='scene' loads a scene"
     for node in scene.graph.nodes_geometry:
         matrix, geometry_name = scene.graph[node]
         geometry = scene.geometry[geometry_name]

@@ -9,7 +9,15 @@ import pytest
 from seminspect.core.errors import InvalidInputError, UnknownNameError
 from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
-from seminspect.graphs.lsg.model import EdgeKind, Layer, TargetStatus
+from seminspect.graphs.lsg.model import (
+    EdgeKind,
+    FeatureNode,
+    Layer,
+    LevelNode,
+    PoseNode,
+    TargetNode,
+    TargetStatus,
+)
 from seminspect.graphs.lsg.optimisation import Outcome
 from seminspect.perception.observation import Observation
 
@@ -230,3 +238,40 @@ def test_edge_paths_run_through_entry_levels_and_via_points() -> None:
     np.testing.assert_allclose(graph.edge_path(edge), [[7, 0, 0.7], [0, 0, 0.7], [0, 17, 0.7]])
     ring = graph.edge("car-0/Level-0/pose-3", "car-0/Level-0")
     np.testing.assert_allclose(graph.edge_path(ring), [[7, 0, 0.7], [7, 0, 0.7]])
+
+
+def _pose(level_id: str, index: int, position) -> PoseNode:
+    name = f"Pose-{index}"
+    return PoseNode(
+        f"{level_id}/{name}", name, index, level_id, np.asarray(position, float),
+        np.array([0.0, 0.0, 0.0, 1.0]), None, 0.0,
+    )  # fmt: skip
+
+
+def _feature(pose_id: str, label: str) -> FeatureNode:
+    level_id = pose_id.rsplit("/", 1)[0]
+    name = f"{label}-1"
+    return FeatureNode(f"{level_id}/{name}", name, label, pose_id, np.ones(3), 0.9, 10, None)
+
+
+def test_nodes_built_by_hand_get_the_edges_of_their_layer() -> None:
+    graph = LayeredSemanticGraph(robot_position=[0, 0, 0.7])
+    car = graph.add_target(
+        TargetNode("car-0", "car", 0, np.array([5.0, 0.0, 0.7]), 0.9, 100, None, 0.0)
+    )
+    assert graph.edge("robot", "car-0").kind is EdgeKind.SYMBOLIC
+    level = LevelNode("car-0/Level-0", "Level-0", 0, "car-0", np.zeros(3), 0.0)
+    with pytest.raises(InvalidInputError, match="first level"):
+        graph.add_level(level, [[1.0, 1.0, 1.0]])
+    first = graph.add_pose(_pose(level.id, 0, [1.0, 1.0, 1.0]))
+    second = graph.add_pose(_pose(level.id, 1, [2.0, 1.0, 1.0]))
+    graph.close_ring(level)
+    assert [p.id for p in car.levels[0].poses] == [first.id, second.id]
+    for u, v in ((level.id, first.id), (first.id, second.id), (level.id, second.id)):
+        assert graph.edge(u, v).kind is EdgeKind.SPATIAL
+    hood = graph.add_feature(_feature(second.id, "hood"))
+    assert graph.edge(second.id, hood.id).kind is EdgeKind.SYMBOLIC
+    with pytest.raises(InvalidInputError, match="is not a PoseNode"):
+        graph.add_feature(
+            FeatureNode("car-0/trunk-1", "trunk-1", "trunk", level.id, np.ones(3), 0.9, 10, None)
+        )

@@ -8,15 +8,15 @@ import shapely
 
 from seminspect.core.errors import FileFormatError, InvalidInputError, PlanningError
 from seminspect.graphs.terrain.evaluate import closest_class, score_places
-from seminspect.graphs.terrain.navigation import nearest_place, shortest_route
-from seminspect.graphs.terrain.params import make_terrain_params
-from seminspect.graphs.terrain.prompting import TaskPrompts
-from seminspect.graphs.terrain.scene_graph import build_terrain_graph
-from seminspect.graphs.terrain.serialization import (
+from seminspect.graphs.terrain.io import (
     load_terrain_graph,
     save_terrain_graph,
     write_graphml,
 )
+from seminspect.graphs.terrain.navigation import nearest_place, shortest_route
+from seminspect.graphs.terrain.params import make_terrain_params
+from seminspect.graphs.terrain.prompting import TaskPrompts
+from seminspect.graphs.terrain.scene_graph import build_terrain_graph
 from seminspect.mapping.ingest import cloud_from_point_data
 from seminspect.mapping.pointfiles import PointData
 

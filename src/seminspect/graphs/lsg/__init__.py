@@ -1,1 +1,38 @@
 """The 3D Layered Semantic Graph of 000 Sec IV: Target -> Level -> Pose -> Feature."""
+
+from seminspect.graphs.lsg.graph import LayeredSemanticGraph, PopulationStats
+from seminspect.graphs.lsg.io import export_graphml, export_spark_dsg, load_graph, save_graph
+from seminspect.graphs.lsg.model import (
+    Edge,
+    EdgeKind,
+    FeatureNode,
+    Layer,
+    LevelNode,
+    PoseNode,
+    RobotNode,
+    TargetNode,
+    TargetStatus,
+)
+from seminspect.graphs.lsg.networkx_view import to_networkx, traversable_networkx
+from seminspect.graphs.lsg.synthetic import synthetic_graph
+
+__all__ = [
+    "Edge",
+    "EdgeKind",
+    "FeatureNode",
+    "Layer",
+    "LayeredSemanticGraph",
+    "LevelNode",
+    "PopulationStats",
+    "PoseNode",
+    "RobotNode",
+    "TargetNode",
+    "TargetStatus",
+    "export_graphml",
+    "export_spark_dsg",
+    "load_graph",
+    "save_graph",
+    "synthetic_graph",
+    "to_networkx",
+    "traversable_networkx",
+]

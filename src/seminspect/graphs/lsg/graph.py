@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -56,6 +57,8 @@ from seminspect.graphs.lsg.optimisation import (
     optimise_targets,
 )
 from seminspect.perception.observation import Observation
+
+N = TypeVar("N", bound=Node)
 
 
 @dataclass(frozen=True, slots=True)
@@ -292,9 +295,7 @@ class LayeredSemanticGraph:
             image=z.image,
             stamp=z.stamp,
         )
-        self._add_to(self.target_graph, target)
-        self._connect(self.target_graph, self.robot, target, EdgeKind.SYMBOLIC)
-        return target
+        return self.add_target(target)
 
     @staticmethod
     def _merge_detection(target: TargetNode, z: Observation) -> None:
@@ -386,22 +387,16 @@ class LayeredSemanticGraph:
     def _new_level(
         self, target: TargetNode, z: Observation, via: ArrayLike | None = None
     ) -> LevelNode:
-        assert target.level_graph is not None
-        previous = target.levels[-1] if target.levels else None
         index = len(target.levels)
-        level_id = naming.join(target.id, naming.level_name(index))
         level = LevelNode(
-            id=level_id,
+            id=naming.join(target.id, naming.level_name(index)),
             name=naming.level_name(index),
             index=index,
             target_id=target.id,
             position=z.position.copy(),
             stamp=z.stamp,
         )
-        self._add_to(target.level_graph, level)
-        self._connect(target.level_graph, target, level, EdgeKind.SYMBOLIC)
-        if previous is not None:
-            self._link(target.level_graph, previous, level, via)
+        self.add_level(level, via)
         self.revision += 1
         return level
 
@@ -422,8 +417,7 @@ class LayeredSemanticGraph:
             image=z.image,
             stamp=z.stamp,
         )
-        self._add_to(level.pose_graph, pose)
-        self._connect(level.pose_graph, poses[-1] if poses else level, pose, EdgeKind.SPATIAL)
+        self.add_pose(pose)
         self.revision += 1
         return pose
 
@@ -456,8 +450,8 @@ class LayeredSemanticGraph:
         if level.closed:
             return LevelSummary(level.id, 0, ())
         poses = level.poses
-        if len(poses) > 1 and close_ring:
-            self._connect(level.pose_graph, poses[-1], level, EdgeKind.SPATIAL)
+        if close_ring:
+            self.close_ring(level)
         kept = optimise_features(inspection.interim, self.params.d_check_F)
         pose_order = {p.id: p.index for p in poses}
         kept.sort(key=lambda f: pose_order[f.pose_id])  # stable: ties keep registration order
@@ -476,10 +470,6 @@ class LayeredSemanticGraph:
     def _add_feature(
         self, level: LevelNode, pose_id: str, z: Observation, ordinal: int
     ) -> FeatureNode:
-        pose = self._nodes[pose_id]
-        assert isinstance(pose, PoseNode)
-        if pose.feature_graph is None:
-            pose.feature_graph = LocalGraph(Layer.FEATURE, pose)
         name = naming.feature_name(z.label, ordinal)
         feature = FeatureNode(
             id=naming.join(level.id, name),
@@ -491,9 +481,7 @@ class LayeredSemanticGraph:
             mask_area=z.mask_area,
             image=z.image,
         )
-        self._add_to(pose.feature_graph, feature)
-        self._connect(pose.feature_graph, pose, feature, EdgeKind.SYMBOLIC)
-        return feature
+        return self.add_feature(feature)
 
     def finish_inspection(self, polygon_level: int = 0) -> TargetNode:
         """Close the last level, build the containment polygon and mark the target inspected.
@@ -575,6 +563,62 @@ class LayeredSemanticGraph:
         if self._inspection is None:
             raise InvalidInputError("no inspection in progress; call begin_inspection first")
         return self._inspection
+
+    # ------------------------------------------------------------------ building from nodes
+    # The registration operators build through these, and so does the file loader: one way to
+    # put a node into its local graph and the unified graph, with the edges its layer implies.
+    def add_target(self, target: TargetNode) -> TargetNode:
+        """Insert a target node into the Target layer, joined to the robot."""
+        self._add_to(self.target_graph, target)
+        self._connect(self.target_graph, self.robot, target, EdgeKind.SYMBOLIC)
+        return target
+
+    def add_level(self, level: LevelNode, via: ArrayLike | None = None) -> LevelNode:
+        """Insert a level after the last level of its target (``level.target_id``), joined to
+        the target and, through ``via`` (M x 3), to the previous level."""
+        target = self._node_of(level.target_id, TargetNode)
+        if target.level_graph is None:
+            target.level_graph = LocalGraph(Layer.LEVEL, target)
+        previous = target.levels[-1] if target.levels else None
+        self._add_to(target.level_graph, level)
+        self._connect(target.level_graph, target, level, EdgeKind.SYMBOLIC)
+        if previous is not None:
+            self._link(target.level_graph, previous, level, via)
+        elif via is not None:
+            raise InvalidInputError(f"{level.id} is the first level; it has no edge to realise")
+        return level
+
+    def add_pose(self, pose: PoseNode) -> PoseNode:
+        """Insert a view pose after the last pose of its level (``pose.level_id``), chained to
+        that pose, or to the level for its first pose."""
+        level = self._node_of(pose.level_id, LevelNode)
+        poses = level.poses
+        self._add_to(level.pose_graph, pose)
+        self._connect(level.pose_graph, poses[-1] if poses else level, pose, EdgeKind.SPATIAL)
+        return pose
+
+    def close_ring(self, level: LevelNode) -> None:
+        """The spatial edge from a level's last pose back to the level, when it has two or
+        more poses."""
+        poses = level.poses
+        if len(poses) > 1:
+            self._connect(level.pose_graph, poses[-1], level, EdgeKind.SPATIAL)
+
+    def add_feature(self, feature: FeatureNode) -> FeatureNode:
+        """Insert a feature into the Feature graph of the pose that observed it
+        (``feature.pose_id``), joined to that pose."""
+        pose = self._node_of(feature.pose_id, PoseNode)
+        if pose.feature_graph is None:
+            pose.feature_graph = LocalGraph(Layer.FEATURE, pose)
+        self._add_to(pose.feature_graph, feature)
+        self._connect(pose.feature_graph, pose, feature, EdgeKind.SYMBOLIC)
+        return feature
+
+    def _node_of(self, node_id: str, kind: type[N]) -> N:
+        node = self.node(node_id)
+        if not isinstance(node, kind):
+            raise InvalidInputError(f"{node_id!r} is not a {kind.__name__}")
+        return node
 
     # ------------------------------------------------------------------ union
     def _add_to(self, local: LocalGraph, node: Node) -> None:

@@ -11,15 +11,17 @@
 
 Loading validates everything a file claims. A malformed, truncated, hostile or wrong-version
 file raises :class:`~seminspect.core.errors.FileFormatError` with one line saying what is wrong.
-A file is rebuilt node by node through the graph's internal union methods, not through the
-registration operators, which would rename and prune what the file holds.
+A file is rebuilt node by node through the graph's public building methods (``add_target``,
+``add_level``, ``add_pose``, ``add_feature``, ``close_ring``), the ones the registration
+operators use, rather than through the operators themselves, which would rename and prune what
+the file holds.
 """
 
 from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Final, Literal
 
 import networkx as nx
 import numpy as np
@@ -34,21 +36,20 @@ from seminspect.core.io import (
 )
 from seminspect.core.params import make_params
 from seminspect.graphs.lsg import naming
-from seminspect.graphs.lsg.convert import node_attributes, to_networkx
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.model import (
     EdgeKind,
     FeatureNode,
     Layer,
     LevelNode,
-    LocalGraph,
     PoseNode,
     TargetNode,
     TargetStatus,
 )
+from seminspect.graphs.lsg.networkx_view import node_attributes, to_networkx
 
-FORMAT = "seminspect.lsg"
-VERSION = 1
+FORMAT: Final = "seminspect.lsg"
+VERSION: Final = 1
 #: Structural limits that keep a hostile file from exhausting memory.
 MAX_ITEMS = 1_000_000
 #: Largest graph file loaded (~17,000 inspected vehicles of 20 views each); see
@@ -315,28 +316,19 @@ def _restore_target(graph: LayeredSemanticGraph, record: TargetRecord) -> None:
         observations=record.observations,
         polygon=None if record.polygon is None else np.asarray(record.polygon, dtype=np.float64),
     )
-    graph._add_to(graph.target_graph, target)
-    graph._connect(graph.target_graph, graph.robot, target, EdgeKind.SYMBOLIC)
+    graph.add_target(target)
     if record.levels and not target.inspected:
         raise InvalidInputError(f"{record.name} has levels but is not inspected")
     if target.inspected and not record.levels:
         raise InvalidInputError(f"{record.name} is inspected but has no levels")
-    if record.levels:
-        target.level_graph = LocalGraph(Layer.LEVEL, target)
-    previous: LevelNode | None = None
     for index, level_record in enumerate(record.levels):
-        previous = _restore_level(graph, target, index, level_record, previous)
+        _restore_level(graph, target, index, level_record)
 
 
 def _restore_level(
-    graph: LayeredSemanticGraph,
-    target: TargetNode,
-    index: int,
-    record: LevelRecord,
-    previous: LevelNode | None,
-) -> LevelNode:
+    graph: LayeredSemanticGraph, target: TargetNode, index: int, record: LevelRecord
+) -> None:
     _expect(record.name, naming.level_name(index))
-    assert target.level_graph is not None
     level = LevelNode(
         id=naming.join(target.id, record.name),
         name=record.name,
@@ -346,27 +338,16 @@ def _restore_level(
         stamp=record.stamp,
         closed=True,
     )
-    graph._add_to(target.level_graph, level)
-    graph._connect(target.level_graph, target, level, EdgeKind.SYMBOLIC)
-    if previous is not None:
-        graph._link(target.level_graph, previous, level, record.via)
-    elif record.via is not None:
-        raise InvalidInputError(f"{level.id} is the first level; it has no edge to realise")
-    before: LevelNode | PoseNode = level
+    graph.add_level(level, record.via)
     for pose_index, pose_record in enumerate(record.poses):
-        before = _restore_pose(graph, level, pose_index, pose_record, before)
-    if len(record.poses) > 1 and record.ring:
-        graph._connect(level.pose_graph, before, level, EdgeKind.SPATIAL)
-    return level
+        _restore_pose(graph, level, pose_index, pose_record)
+    if record.ring:
+        graph.close_ring(level)
 
 
 def _restore_pose(
-    graph: LayeredSemanticGraph,
-    level: LevelNode,
-    index: int,
-    record: PoseRecord,
-    before: LevelNode | PoseNode,
-) -> PoseNode:
+    graph: LayeredSemanticGraph, level: LevelNode, index: int, record: PoseRecord
+) -> None:
     _expect(record.name, naming.pose_name(index))
     pose = PoseNode(
         id=naming.join(level.id, record.name),
@@ -378,12 +359,9 @@ def _restore_pose(
         image=record.image,
         stamp=record.stamp,
     )
-    graph._add_to(level.pose_graph, pose)
-    graph._connect(level.pose_graph, before, pose, EdgeKind.SPATIAL)
-    if record.features:
-        pose.feature_graph = LocalGraph(Layer.FEATURE, pose)
+    graph.add_pose(pose)
     for feature in record.features:
-        node = FeatureNode(
+        feature_node = FeatureNode(
             id=naming.join(level.id, feature.name),
             name=feature.name,
             label=feature.label,
@@ -393,9 +371,7 @@ def _restore_pose(
             mask_area=feature.mask_area,
             image=feature.image,
         )
-        graph._add_to(pose.feature_graph, node)
-        graph._connect(pose.feature_graph, pose, node, EdgeKind.SYMBOLIC)
-    return pose
+        graph.add_feature(feature_node)
 
 
 def _expect(found: str, expected: str) -> None:

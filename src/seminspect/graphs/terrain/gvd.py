@@ -110,7 +110,10 @@ def voronoi_cells(
     free: NDArray[np.bool_], distance: NDArray[np.float64], nearest: NDArray[np.int64]
 ) -> NDArray[np.bool_]:
     """Lau et al.'s Voronoi test on every pair of 4-neighbours (vectorised)."""
-    rows, cols = np.indices(free.shape)
+    index = np.indices(free.shape)
+    rows, cols = index[0, :, :], index[1, :, :]
+    near_rows: NDArray[np.int64] = nearest[0, :, :]
+    near_cols: NDArray[np.int64] = nearest[1, :, :]
     squared = np.rint(distance**2).astype(np.int64)
     voronoi = np.zeros(free.shape, dtype=bool)
     for axis in (0, 1):
@@ -118,8 +121,8 @@ def voronoi_cells(
         there = [slice(None), slice(None)]
         here[axis], there[axis] = slice(None, -1), slice(1, None)
         s, n = tuple(here), tuple(there)
-        obst_s = (nearest[0][s], nearest[1][s])
-        obst_n = (nearest[0][n], nearest[1][n])
+        obst_s = (near_rows[s], near_cols[s])
+        obst_n = (near_rows[n], near_cols[n])
         gap = np.maximum(np.abs(obst_s[0] - obst_n[0]), np.abs(obst_s[1] - obst_n[1]))
         apart = gap > _OBSTACLE_GAP
         candidate = free[s] & free[n] & ((squared[s] > 1) | (squared[n] > 1)) & apart

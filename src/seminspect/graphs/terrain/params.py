@@ -7,7 +7,7 @@ from collections.abc import Mapping
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from seminspect.core.config import build
+from seminspect.core.validation import build
 
 
 class TerrainGraphParams(BaseModel):

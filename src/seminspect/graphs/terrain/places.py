@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -86,8 +87,13 @@ def _terrain_grid(
     cells = frame.cells_of(points)
     flat = np.ravel_multi_index((cells[:, 0], cells[:, 1]), frame.shape)
     size = frame.shape[0] * frame.shape[1]
-    counts = np.bincount(flat, minlength=size).reshape(frame.shape).astype(np.float64)
-    heights = np.bincount(flat, weights=points[:, 2], minlength=size).reshape(frame.shape)
+    counts: NDArray[np.float64] = (
+        np.bincount(flat, minlength=size).reshape(frame.shape).astype(np.float64)
+    )
+    heights = cast(
+        "NDArray[np.float64]",
+        np.bincount(flat, weights=points[:, 2], minlength=size).reshape(frame.shape),
+    )
     return counts >= min_points, counts, heights
 
 

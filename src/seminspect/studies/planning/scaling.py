@@ -14,6 +14,7 @@ import math
 import statistics
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -24,11 +25,11 @@ from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.model import FeatureNode
 from seminspect.graphs.lsg.synthetic import VEHICLE_SIZE, synthetic_graph, synthetic_layout
 from seminspect.mapping.voxel import VoxelMap
-from seminspect.planning.comparison import time_hierarchical, time_volumetric
 from seminspect.planning.gridmap import CostModel
 from seminspect.planning.hierarchical import HierarchicalPlanner
 from seminspect.planning.local import DEFAULT_GROUND_BAND
 from seminspect.planning.volumetric import VolumetricPlanner
+from seminspect.studies.planning.comparison import time_hierarchical, time_volumetric
 
 #: City sizes (vehicles) of the default study: the paper's 20 up to a hundred times more.
 SCALING_SIZES = (20, 50, 100, 200, 500, 1000, 2000)
@@ -94,7 +95,7 @@ def scaling_point(
     search, plan_s, settled, vp, expansions, ratio_search, ratio_plan = ([] for _ in range(7))
     failures = 0
     for start, goal in random_queries(graph, queries, seed):
-        route, timing = time_hierarchical(lambda s=start, g=goal: hierarchical.plan(g, s), repeats)
+        route, timing = time_hierarchical(partial(hierarchical.plan, goal, start), repeats)
         answer = time_volumetric(volumetric, start, route.waypoints[-1], repeats=1)
         search.append(timing.search_s)
         plan_s.append(timing.plan_s)

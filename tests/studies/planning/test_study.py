@@ -10,8 +10,13 @@ from seminspect.core.errors import InvalidInputError
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.synthetic import synthetic_graph
 from seminspect.mapping.voxel import VoxelMap, save_map
-from seminspect.missions import planning_study, sweep
-from seminspect.missions.planning_study import (
+from seminspect.missions import sweep
+from seminspect.missions.rundir import RunDirectory, reusable_run
+from seminspect.perception.observation import Observation
+from seminspect.planning.hierarchical import HierarchicalPlanner
+from seminspect.studies.planning import study as planning_study
+from seminspect.studies.planning.comparison import HierarchicalTiming, VolumetricResult
+from seminspect.studies.planning.study import (
     MissionOutcome,
     PathCheck,
     QueryComparison,
@@ -22,10 +27,6 @@ from seminspect.missions.planning_study import (
     select_queries,
     study_config,
 )
-from seminspect.missions.rundir import RunDirectory, reusable_run
-from seminspect.perception.observation import Observation
-from seminspect.planning.comparison import HierarchicalTiming, VolumetricResult
-from seminspect.planning.hierarchical import HierarchicalPlanner
 
 
 def test_queries_spread_from_the_nearest_to_the_farthest_target() -> None:
@@ -125,6 +126,7 @@ def test_table_6_runs_charge_planning_under_the_papers_budget() -> None:
         study_config("huge")
 
 
+@pytest.mark.slow
 def test_a_run_is_compared_query_by_query(small_mission_dir: Path) -> None:
     result = compare_run(small_mission_dir, count=3, repeats=3, vp_repeats=1, resolutions=(0.5,))
     assert len(result.queries) == 3 and result.inspected_targets >= 3
@@ -138,6 +140,7 @@ def test_a_run_is_compared_query_by_query(small_mission_dir: Path) -> None:
         assert math.isfinite(q.time_ratio(0.5, "query")) and q.hp.repeats == 3
 
 
+@pytest.mark.slow
 def test_the_full_volume_baseline_searches_every_height(small_mission_dir: Path) -> None:
     args = {"count": 2, "repeats": 1, "vp_repeats": 1, "resolutions": (0.5,)}
     ground = compare_run(small_mission_dir, **args)
@@ -154,6 +157,7 @@ def test_the_full_volume_baseline_searches_every_height(small_mission_dir: Path)
     assert sum(q.vp_checks[0].segments for q in full.queries) > 10
 
 
+@pytest.mark.slow
 def test_an_unknown_volume_is_refused(small_mission_dir: Path) -> None:
     with pytest.raises(InvalidInputError, match="unknown volume 'sky'"):
         compare_run(small_mission_dir, volume="sky")
@@ -161,6 +165,7 @@ def test_an_unknown_volume_is_refused(small_mission_dir: Path) -> None:
         planning_study.run_study(["small"], small_mission_dir.parent, volume="sky")
 
 
+@pytest.mark.slow
 def test_mission_outcomes_are_read_from_the_metrics(small_mission_dir: Path) -> None:
     outcome = MissionOutcome.read(small_mission_dir, "small", "hierarchical")
     assert outcome.inspected >= 3 and outcome.sim_time_s > 0 and outcome.planning_wall_s > 0

@@ -185,7 +185,8 @@ class _FineCheck:
         near = np.all((self.low <= upper) & (self.high >= lower), axis=1)
         if not near.any():
             return True
-        shape = tuple(int(n) for n in np.ceil((upper - lower) / self.resolution))
+        nx, ny, nz = (int(n) for n in np.ceil((upper - lower) / self.resolution))
+        shape = (nx, ny, nz)
         touched = cells_touching_triangles(self.triangles[near], lower, self.resolution, shape)
         centres = lower + (np.argwhere(touched) + 0.5) * self.resolution
         return bool(_distance_to_segment(centres, a, b).min(initial=np.inf) >= self.needed)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import cv2
 import numpy as np
@@ -69,7 +69,7 @@ def _median_depth(frame: Frame, mask: NDArray[np.bool_]) -> float:
 
 def _distort(mask: NDArray[np.bool_], background: NDArray[np.bool_], noise: NoiseModel):
     """Erode the mask, then let it bleed into neighbouring background pixels."""
-    shaped = mask.astype(np.uint8)
+    shaped: NDArray[Any] = mask.astype(np.uint8)
     kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (3, 3))
     if noise.mask_erosion_px:
         shaped = cv2.erode(shaped, kernel, iterations=noise.mask_erosion_px)

@@ -210,7 +210,7 @@ def write_graphml(path: str | Path, scene: TerrainSceneGraph) -> Path:
     """GraphML for other tools: vectors become ``_x``/``_y``/``_z`` scalar attributes."""
     flat = nx.Graph()
     for node, data in scene.graph.nodes(data=True):
-        attributes = {}
+        attributes: dict[str, Any] = {}
         for key, value in data.items():
             if key in _VECTORS:
                 attributes.update(

@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from seminspect.core.errors import InvalidInputError
-from seminspect.planning.search import CsrGraph, shortest_path
+from seminspect.planning.graph_search import CsrGraph, shortest_path
 
 
 @st.composite

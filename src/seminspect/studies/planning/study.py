@@ -45,7 +45,11 @@ from seminspect.missions.rundir import (
 )
 from seminspect.missions.sweep import run_or_reuse
 from seminspect.missions.xflie import PLANNING_MARGIN, MissionProgress
-from seminspect.planning.comparison import (
+from seminspect.planning.gridmap import CostGrid, CostModel
+from seminspect.planning.hierarchical import HierarchicalPlanner
+from seminspect.planning.smoothing import refine_path
+from seminspect.planning.volumetric import VolumetricPlanner
+from seminspect.studies.planning.comparison import (
     HierarchicalTiming,
     VolumetricResult,
     fine_segment_validity,
@@ -53,11 +57,7 @@ from seminspect.planning.comparison import (
     time_hierarchical,
     time_volumetric,
 )
-from seminspect.planning.gridmap import CostGrid, CostModel
-from seminspect.planning.hierarchical import HierarchicalPlanner
-from seminspect.planning.scaling import SCALING_SIZES, ScalingPoint, scaling_study
-from seminspect.planning.smoothing import refine_path
-from seminspect.planning.volumetric import VolumetricPlanner
+from seminspect.studies.planning.scaling import SCALING_SIZES, ScalingPoint, scaling_study
 from seminspect.worlds import World
 
 CITY_SCENARIOS = ("small", "medium", "large")
@@ -474,7 +474,7 @@ class MissionOutcome:
     planner: str
     run_dir: Path
     cpu_load_pct: float
-    planning_load_pct: float
+    planning_load_pct: float | None
     planning_wall_s: float
     bbox_volume_m3: float
     surface_coverage_pct: float | None
@@ -488,22 +488,22 @@ class MissionOutcome:
     @classmethod
     def read(cls, run_dir: Path, scenario: str, planner: str) -> MissionOutcome:
         metrics = read_run_metrics(run_dir)
-        t6, mission, targets = metrics["table6"], metrics["mission"], metrics["targets"]
+        t6, mission, targets = metrics.table6, metrics.mission, metrics.targets
         return cls(
             scenario=scenario,
             planner=planner,
             run_dir=run_dir,
-            cpu_load_pct=t6["cpu_load_pct"],
-            planning_load_pct=t6["planning_load_pct"],
-            planning_wall_s=mission["planning_wall_s"],
-            bbox_volume_m3=t6["bbox_volume_m3"],
-            surface_coverage_pct=t6["surface_coverage_pct"],
-            rmse_m=t6["localisation_rmse_m"],
-            inspected=targets["inspected"],
-            true_targets=targets["true"],
-            sim_time_s=mission["sim_time_s"],
-            wall_time_s=mission["wall_time_s"],
-            route_plans=mission["local_plans"],
+            cpu_load_pct=t6.cpu_load_pct,
+            planning_load_pct=t6.planning_load_pct,
+            planning_wall_s=mission.planning_wall_s,
+            bbox_volume_m3=t6.bbox_volume_m3,
+            surface_coverage_pct=t6.surface_coverage_pct,
+            rmse_m=t6.localisation_rmse_m,
+            inspected=targets.inspected,
+            true_targets=targets.true,
+            sim_time_s=mission.sim_time_s,
+            wall_time_s=mission.wall_time_s,
+            route_plans=mission.local_plans,
         )
 
 

@@ -51,7 +51,7 @@ def trajectory_figure(world: World, graph: LayeredSemanticGraph, trajectory: np.
         ax.plot(*target.position[:2], marker="o", color=colour, markersize=6)
         ax.annotate(
             target.id,
-            target.position[:2],
+            tuple(target.position[:2]),
             fontsize=7,
             color=colour,
             xytext=(4, 4),

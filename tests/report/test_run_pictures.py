@@ -1,7 +1,10 @@
+import pytest
+
 from seminspect.missions.rundir import load_trajectory
-from seminspect.report.mission import load_events, render_run
+from seminspect.report.run_pictures import load_events, render_run
 
 
+@pytest.mark.slow
 def test_pictures_are_drawn_from_the_run_directory_alone(small_mission_dir) -> None:
     written = render_run(small_mission_dir)
     assert [p.name for p in written] == ["trajectory.png", "graph.png", "utility.png"]

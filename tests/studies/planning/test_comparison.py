@@ -8,16 +8,16 @@ import pytest
 from seminspect.core.errors import InvalidInputError
 from seminspect.graphs.lsg.synthetic import synthetic_graph
 from seminspect.mapping.voxel import FREE, OCCUPIED, VoxelMap
-from seminspect.planning.comparison import (
+from seminspect.planning.gridmap import CostModel
+from seminspect.planning.hierarchical import HierarchicalPlanner
+from seminspect.planning.volumetric import VolumetricPlanner
+from seminspect.studies.planning.comparison import (
     fine_segment_validity,
     segment_validity,
     time_hierarchical,
     time_volumetric,
 )
-from seminspect.planning.gridmap import CostModel
-from seminspect.planning.hierarchical import HierarchicalPlanner
-from seminspect.planning.scaling import box_city, growth_exponent, scaling_point
-from seminspect.planning.volumetric import VolumetricPlanner
+from seminspect.studies.planning.scaling import box_city, growth_exponent, scaling_point
 from sim_worlds import box_world
 
 

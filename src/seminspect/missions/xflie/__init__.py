@@ -1,0 +1,18 @@
+"""The xFLIE mission (000 Sec V): a short executive loop over one module per phase.
+
+* :mod:`.executive`: :class:`XFlie`, the loop that runs the phases in turn;
+* :mod:`.context`: :class:`MissionContext`, the state the phases share;
+* :mod:`.sightings`: registering detections (eqs 3-5) and finding one target in a frame;
+* :mod:`.exploration`: 360-degree surveys and frontier hops, with their memory;
+* :mod:`.approach`: the route to a selected target (graph leg, then local) and its confirmation;
+* :mod:`.inspection`: ``π^insp`` level by level (eqs 7, 9, 10) and climbing;
+* :mod:`.surface`: surface tracking and view steps (002 eqs 1-2);
+* :mod:`.completion`: the end of a level by scene similarity (eq 8) or the safety cap;
+* :mod:`.links`: Target-layer edges between inspected targets and their first routes.
+"""
+
+from seminspect.missions.xflie.approach import PLANNING_MARGIN
+from seminspect.missions.xflie.context import MissionContext
+from seminspect.missions.xflie.executive import MissionProgress, XFlie
+
+__all__ = ["PLANNING_MARGIN", "MissionContext", "MissionProgress", "XFlie"]

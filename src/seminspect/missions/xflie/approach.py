@@ -1,0 +1,140 @@
+"""The approach to a selected target: route there, then confirm it is really there.
+
+The route has two parts. The known part runs over the 3DLSG with the hierarchical planner, to
+the traversable node nearest the goal (when the graph gets the robot closer than driving
+straight); the rest is planned on the robot's own occupancy map into unknown space, to within
+``ε`` of the target (eq 2's proximity condition). With ``planner="volumetric"`` (000 Sec VII-D's
+baseline) the volumetric planner plans the whole way instead.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from seminspect.core.errors import PlanningError
+from seminspect.graphs.lsg.model import TargetNode, TargetStatus
+from seminspect.missions.config import ResolvedMissionConfig
+from seminspect.missions.navigation import RoutePlanner
+from seminspect.missions.platform import heading_to
+from seminspect.missions.xflie.context import MissionContext
+from seminspect.missions.xflie.sightings import register_targets, target_view
+from seminspect.planning.gridmap import CostModel
+from seminspect.planning.hierarchical import HierarchicalPlanner
+from seminspect.planning.local import LocalPlanner
+from seminspect.planning.smoothing import refine_path
+from seminspect.planning.volumetric import RebuildingVolumetricPlanner
+
+#: Extra clearance added to the robot radius in the planners' inflation [m].
+PLANNING_MARGIN = 0.2
+#: Risk band of the local planner's cost model [m].
+LOCAL_RISK_RADIUS = 0.3
+#: The volumetric baseline's map resolution and risk band (000 Sec VII-D: D*+ on M_0.4, risk
+#: parameter 0.2) [m].
+BASELINE_RESOLUTION = 0.4
+BASELINE_RISK_RADIUS = 0.2
+#: Extra arrival radii tried, beyond ``ε``, when the robot cannot come within ``ε`` [m].
+ARRIVAL_FALLBACKS = (0.0, 1.0, 2.5)
+#: Headings tried when confirming a target: straight at it, then either side [rad].
+CONFIRM_OFFSETS = (0.0, math.radians(35), -math.radians(35))
+#: The graph leg is skipped unless it ends this much closer to the goal than the robot is [m].
+GRAPH_LEG_GAIN = 5.0
+
+
+class Approach:
+    """Reaching a target and confirming it on arrival.
+
+    Args:
+        ctx: the mission's shared state.
+        planner: the hierarchical planner over the mission's graph.
+        baseline: the volumetric baseline planner, when it replaces the local planner.
+    """
+
+    def __init__(
+        self,
+        ctx: MissionContext,
+        planner: HierarchicalPlanner,
+        baseline: RoutePlanner | None = None,
+    ) -> None:
+        self.ctx = ctx
+        self.planner = planner
+        self.baseline = baseline
+
+    def reach(self, target: TargetNode) -> bool:
+        """Navigate to within ``ε`` of a detected target (eq 2's proximity condition)."""
+        ctx = self.ctx
+        goal = target.position
+        ctx.event("selected", target=target.id, utility=round(target.utility, 4))
+        self.graph_leg(goal)
+        for extra in ARRIVAL_FALLBACKS:
+            radius = ctx.params.epsilon + extra
+            if ctx.navigator.go_to(goal, radius, planner=self.baseline):
+                ctx.event("arrived", target=target.id)
+                return True
+            if ctx.time_left <= 0:
+                return False
+        return False
+
+    def confirm(self, target: TargetNode) -> bool:
+        """Look for the target from where the robot arrived: straight at it, then either side.
+
+        A detection that is not there when the robot comes to look (a false positive of the
+        segmentation, or a badly localised one) is discarded rather than inspected.
+        """
+        ctx = self.ctx
+        facing = heading_to(ctx.platform.position, target.position)
+        for offset in CONFIRM_OFFSETS:
+            ctx.platform.turn_to(facing + offset)
+            frame = ctx.capture()
+            register_targets(ctx, frame)
+            if target.id not in ctx.graph:  # merged away by eq (4) after a better view
+                return False
+            _, points = target_view(ctx, frame, target, ctx.params.d_check_T)
+            if len(points):
+                ctx.platform.turn_to(facing)
+                return True
+        return False
+
+    def graph_leg(self, goal: NDArray[np.float64]) -> None:
+        """The known part of the route: over the 3DLSG to the traversable node nearest ``goal``."""
+        ctx = self.ctx
+        if not ctx.graph.targets(TargetStatus.INSPECTED) or ctx.config.planner != "hierarchical":
+            return
+        with ctx.timers("planning"):
+            entry = self.planner.nearest_entry(goal)
+            entry_position = ctx.graph.node(entry).position
+            here = ctx.platform.position
+            if np.linalg.norm((goal - entry_position)[:2]) + GRAPH_LEG_GAIN >= np.linalg.norm(
+                (goal - here)[:2]
+            ):
+                return  # the graph gets the robot no closer than driving straight for it
+            try:
+                plan = self.planner.plan(entry, here)
+            except PlanningError:  # the Target layer does not join the two; drive without it
+                return
+            ctx.recorder.plan(entry, plan)
+            refined = refine_path(plan.waypoints, ctx.navigator.cost_grid())
+            ctx.navigator.planned(plan.timing.total_s + refined.refine_time)
+            route = refined.waypoints
+        ctx.navigator.drive(route)
+
+
+def local_planner(config: ResolvedMissionConfig) -> LocalPlanner:
+    """The robot's planner on its own map: routes may enter unknown space at a cost."""
+    clearance = config.robot.radius + PLANNING_MARGIN
+    model = CostModel(clearance, risk_radius=LOCAL_RISK_RADIUS, unknown_cost=1.0)
+    return LocalPlanner(model, config.mode, band=config.robot.planning_band())
+
+
+def baseline_planner(config: ResolvedMissionConfig) -> RebuildingVolumetricPlanner | None:
+    """000 Sec VII-D's volumetric baseline, when the mission uses it (``planner="volumetric"``)."""
+    if config.planner != "volumetric":
+        return None
+    clearance = config.robot.radius + PLANNING_MARGIN
+    return RebuildingVolumetricPlanner(
+        CostModel(clearance, risk_radius=BASELINE_RISK_RADIUS, unknown_cost=1.0),
+        config.robot.planning_band() if config.mode == "ground" else None,
+        resolution=BASELINE_RESOLUTION,
+    )

@@ -1,0 +1,88 @@
+"""What every phase of an xFLIE mission shares: the robot, its map, the graph and the recorder."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+
+from seminspect.core.params import InspectionParams
+from seminspect.geometry.transforms import quat_from_yaw
+from seminspect.graphs.lsg.graph import LayeredSemanticGraph
+from seminspect.mapping.voxel import VoxelMap
+from seminspect.missions.config import ResolvedMissionConfig
+from seminspect.missions.metrics import Timers
+from seminspect.missions.navigation import Navigator
+from seminspect.missions.platform import Platform
+from seminspect.missions.recorder import MissionRecorder
+from seminspect.missions.rundir import RunDirectory
+from seminspect.perception.observation import Observation
+from seminspect.sensors import Detection, Frame
+
+#: Every DEPTH_STRIDE-th pixel (rows and columns) of a depth frame goes into the map.
+DEPTH_STRIDE = 8
+
+
+@dataclass
+class MissionContext:
+    """The state the phases of one mission share.
+
+    Attributes:
+        min_height: object points below this height are bled pixels on the ground [m].
+        unreachable: targets given up on (not reached, or too few views to inspect).
+        frames_seen: camera frames taken so far (they number the saved images).
+        on_step: called when a phase has made progress worth showing.
+    """
+
+    config: ResolvedMissionConfig
+    platform: Platform
+    occupancy: VoxelMap
+    graph: LayeredSemanticGraph
+    navigator: Navigator
+    recorder: MissionRecorder
+    run: RunDirectory | None
+    min_height: float
+    unreachable: set[str] = field(default_factory=set)
+    frames_seen: int = 0
+    on_step: Callable[[], None] = lambda: None
+
+    @property
+    def params(self) -> InspectionParams:
+        return self.config.params
+
+    @property
+    def timers(self) -> Timers:
+        return self.recorder.timers
+
+    @property
+    def time_left(self) -> float:
+        return self.config.time_budget_s - self.platform.time
+
+    def event(self, kind: str, **fields: object) -> None:
+        self.recorder.event(kind, **fields)
+
+    def capture(self) -> Frame:
+        """A camera frame, integrated into the robot's map."""
+        with self.timers("sensing"):
+            frame = self.platform.capture()
+        self.integrate(frame)
+        return frame
+
+    def integrate(self, frame: Frame) -> None:
+        """Put a frame's depth into the map."""
+        with self.timers("sensing"):
+            self.occupancy.integrate_frame(frame, stride=DEPTH_STRIDE, use_odometry=True)
+        self.frames_seen += 1
+
+    def detect(self, frame: Frame, level: str, labels: Iterable[str]) -> list[Detection]:
+        """Segmentations at or above the confidence threshold."""
+        detections = self.platform.detect(frame, level, labels)
+        return [d for d in detections if d.score >= self.config.min_score]
+
+    def view_pose(self, image: str | None) -> Observation:
+        """The robot's current pose as a view-pose observation (eq 9)."""
+        return Observation.view_pose(
+            self.platform.position,
+            quat_from_yaw(self.platform.yaw),
+            image=image,
+            stamp=self.platform.time,
+        )

@@ -1,0 +1,146 @@
+"""Surface tracking and view steps: how the robot moves around a target during a level.
+
+What the robot keeps its distance from is the target's points in view together with every
+LiDAR return attached to what it has seen of the target (so parts out of the camera's view,
+and debris beside it, count too). FLIE's local view planner (002 eqs 1-2) gives the next view
+pose along that surface; blocked steps are retried shorter, then closer to the surface.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial import cKDTree
+
+from seminspect.core.errors import PlanningError
+from seminspect.graphs.lsg.model import TargetNode
+from seminspect.missions.xflie.context import MissionContext
+from seminspect.planning.view_planner import ViewConstraints, next_view_pose
+
+#: Voxel size of the cloud kept of the target under inspection [m].
+TARGET_VOXEL = 0.2
+#: LiDAR returns closer than this to the target's cloud belong to it or stand beside it [m].
+ATTACHED = 1.5
+#: Fractions of the full view-planner step tried, in order, when a step is blocked.
+STEP_SCALES = (1.0, 0.5, 0.25)
+#: Fractions of the viewing distance tried, in order, when no step is free at the full one.
+VIEW_DISTANCE_SCALES = (1.0, 0.75)
+#: A view move shorter than this does not count as a step along the surface [m].
+MIN_VIEW_STEP = 0.1
+
+
+class PointSet:
+    """Points thinned to one per voxel, with radius queries."""
+
+    def __init__(self, voxel: float) -> None:
+        self.voxel = voxel
+        self.points: NDArray[np.float64] = np.empty((0, 3))
+        self._tree: cKDTree | None = None
+
+    @property
+    def size(self) -> int:
+        return len(self.points)
+
+    def add(self, points: NDArray[np.float64]) -> None:
+        merged = np.vstack([self.points, points])
+        _, first = np.unique(
+            np.floor(merged / self.voxel).astype(np.int64), axis=0, return_index=True
+        )
+        self.points = merged[np.sort(first)]
+        self._tree = None
+
+    def near(self, points: NDArray[np.float64], radius: float) -> NDArray[np.bool_]:
+        """Which ``points`` lie within ``radius`` of the set."""
+        if self._tree is None:
+            self._tree = cKDTree(self.points)
+        distance, _ = self._tree.query(points, distance_upper_bound=radius)
+        return np.isfinite(distance)
+
+
+class SurfaceTracker:
+    """The surface of the target under inspection, and steps along it (002 eqs 1-2).
+
+    Args:
+        ctx: the mission's shared state.
+        view: the view planner's constraints (viewing distance, overlaps, fields of view).
+    """
+
+    def __init__(self, ctx: MissionContext, view: ViewConstraints) -> None:
+        self.ctx = ctx
+        self.view = view
+        #: Everything seen of the target under inspection, thinned to ``TARGET_VOXEL``.
+        self.target_cloud = PointSet(TARGET_VOXEL)
+
+    def start_target(self) -> None:
+        """Forget the previous target's cloud."""
+        self.target_cloud = PointSet(TARGET_VOXEL)
+
+    def surface(self, mask_points: NDArray[np.float64]) -> NDArray[np.float64]:
+        """What the view planner steps along: the target's points in view, and every LiDAR
+        return attached to the target (within ``ATTACHED`` of anything seen of it), so that
+        parts of it out of the camera's view and debris beside it are kept at a distance too."""
+        scan = self.ctx.navigator.last_scan
+        if scan is None or not self.target_cloud.size:
+            return mask_points
+        returns = scan.points[scan.points[:, 2] >= self.ctx.min_height]
+        attached = returns[self.target_cloud.near(returns, ATTACHED)]
+        return np.vstack([mask_points, attached]) if len(mask_points) else attached
+
+    def step_along(self, surface: NDArray[np.float64], target: TargetNode) -> bool:
+        """Move to the next view pose of 002 eqs (1)-(2); False when no step is possible.
+
+        When the full step is blocked, shorter steps along the surface are tried, and then the
+        same steps from closer to the surface (where the space around the target is too tight
+        for the viewing distance, as beside a car in a tunnel), before giving up.
+        """
+        ctx = self.ctx
+        points = self.in_view(surface) if len(surface) else target.position[None, :]
+        for closer, scale in itertools.product(VIEW_DISTANCE_SCALES, STEP_SCALES):
+            overlap = 1.0 - (1.0 - self.view.overlap_h) * scale
+            view = self.view.model_copy(
+                update={"overlap_h": overlap, "d_view": self.view.d_view * closer}
+            )
+            with ctx.timers("planning"):
+                started = time.perf_counter()
+                try:
+                    pose = next_view_pose(ctx.platform.position, points, view)
+                except PlanningError:
+                    return False
+                finally:
+                    ctx.navigator.planned(time.perf_counter() - started)
+            if self.move_to_view(pose.position, pose.yaw):
+                return True
+        return False
+
+    def in_view(self, surface: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The surface up to the top of the view: parts above it do not limit the level, while
+        anything below the robot (a collapsed slab, rubble) must keep its distance too."""
+        reach = math.tan(math.radians(self.view.vfov_deg) / 2) * self.view.d_view
+        below = surface[surface[:, 2] <= self.ctx.platform.position[2] + reach]
+        return below if len(below) else surface
+
+    def move_to_view(self, goal: NDArray[np.float64], yaw: float) -> bool:
+        """A short move beside the structure. Aerial robots keep to space they have seen to be
+        free: below and beside a flying robot lies what its sensors see least."""
+        ctx = self.ctx
+        platform, navigator = ctx.platform, ctx.navigator
+        known_only = ctx.config.mode == "aerial"
+        if ctx.config.mode == "ground":
+            goal = np.array([goal[0], goal[1], platform.position[2]])
+        step = float(np.linalg.norm(goal - platform.position))
+        if step < MIN_VIEW_STEP:
+            return False
+        if navigator.segment_is_free(platform.position, goal, known_only=known_only):
+            with ctx.timers("driving"):
+                motion = platform.move_to(goal, yaw)
+            navigator.mark_contact(motion.contact)
+            navigator.sense_lidar()
+            if motion.reached:
+                return True
+        return navigator.go_to(
+            goal, radius=min(0.5, 0.25 * step), final_yaw=yaw, attempts=2, known_only=known_only
+        )

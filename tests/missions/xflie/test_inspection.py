@@ -1,0 +1,63 @@
+import numpy as np
+
+from fake_platform import FakePlatform, fake_context
+from seminspect.graphs.lsg.model import TargetStatus
+from seminspect.missions.xflie.inspection import LevelInspection, dilate, platform_vfov
+from seminspect.perception.observation import Observation
+from seminspect.planning.view_planner import ViewConstraints
+
+
+def inspection_of_a_car(platform=None, settings=None):
+    ctx, events = fake_context(platform or FakePlatform(), settings=settings)
+    ctx.graph.register_target(Observation([3.5, 0.0, 0.7], label="car", score=0.9, mask_area=1))
+    ctx.graph.optimise_targets()
+    view = ViewConstraints(
+        d_view=ctx.config.inspection.d_view,
+        overlap_h=0.6,
+        overlap_v=0.6,
+        hfov_deg=ctx.params.fov_deg,
+        vfov_deg=platform_vfov(ctx.params),
+    )
+    inspection = LevelInspection(ctx, view, camera_pitch=0.0)
+    return ctx, events, inspection, ctx.graph.target("car-0")
+
+
+def test_a_ground_robot_circles_the_target_once_and_leaves_it_inspected() -> None:
+    ctx, events, inspection, car = inspection_of_a_car(FakePlatform(position=(1.0, 0.0, 0.7)))
+    assert inspection.inspect(car)
+    assert car.status is TargetStatus.INSPECTED and len(car.levels) == 1
+    assert len(car.levels[0].poses) >= 3
+    assert inspection.closed_levels == [True]  # ended by the cap: blank images never match
+    assert events.kinds().count("level-complete") == 1
+    assert ctx.recorder.record().level_endings.cap == 1
+    assert not ctx.unreachable
+
+
+def test_an_inspection_with_too_few_views_is_cancelled() -> None:
+    platform = FakePlatform(position=(1.0, 0.0, 0.7))
+    ctx, events, inspection, car = inspection_of_a_car(platform)
+    platform.wait(ctx.config.time_budget_s - 1.0)  # time for one view only
+    assert not inspection.inspect(car)
+    assert ctx.unreachable == {"car-0"}
+    assert "inspection-cancelled" in events.kinds()
+    assert car.status is not TargetStatus.INSPECTED and ctx.graph.inspecting is None
+
+
+def test_an_aerial_robot_climbs_only_while_the_target_rises_above_its_view() -> None:
+    platform = FakePlatform(position=(1.0, 0.0, 2.0))
+    ctx, events, inspection, car = inspection_of_a_car(platform, settings={"mode": "aerial"})
+    with ctx.timers("graph"):
+        ctx.graph.begin_inspection(car.id, ctx.view_pose(image=None))
+    assert not inspection.climb(car, heights=[2.5])  # the view already reaches the top
+    assert platform.position[2] == 2.0
+    assert inspection.climb(car, heights=[12.0])
+    assert platform.position[2] == 2.0 + inspection.view.vertical_step
+    assert events.kinds()[-1] == "level" and len(car.levels) == 2
+
+
+def test_a_mask_grows_by_four_connected_steps() -> None:
+    mask = np.zeros((9, 9), bool)
+    mask[4, 4] = True
+    grown = dilate(mask, 2)
+    assert grown.sum() == 13  # a diamond of radius 2
+    assert grown[4, 6] and grown[2, 4] and not grown[6, 6]

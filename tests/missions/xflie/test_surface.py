@@ -1,0 +1,79 @@
+import numpy as np
+
+from fake_platform import FakePlatform, fake_context
+from seminspect.missions.xflie.inspection import platform_vfov
+from seminspect.missions.xflie.surface import ATTACHED, MIN_VIEW_STEP, PointSet, SurfaceTracker
+from seminspect.perception.observation import Observation
+from seminspect.planning.view_planner import ViewConstraints
+
+
+def tracker(platform: FakePlatform | None = None) -> SurfaceTracker:
+    ctx, _ = fake_context(platform)
+    view = ViewConstraints(
+        d_view=2.5,
+        overlap_h=0.6,
+        overlap_v=0.6,
+        hfov_deg=ctx.params.fov_deg,
+        vfov_deg=platform_vfov(ctx.params),
+    )
+    return SurfaceTracker(ctx, view)
+
+
+def wall(x: float = 3.0) -> np.ndarray:
+    """Points of a 4 m wide, 1.5 m high wall facing the robot."""
+    ys, zs = np.meshgrid(np.linspace(-2, 2, 21), np.linspace(0.2, 1.5, 7))
+    return np.column_stack([np.full(ys.size, x), ys.ravel(), zs.ravel()])
+
+
+def test_a_point_set_keeps_one_point_per_voxel_and_answers_radius_queries() -> None:
+    points = PointSet(0.2)
+    points.add(np.array([[0.01, 0.01, 0.01], [0.05, 0.05, 0.05], [1.0, 0.0, 0.0]]))
+    assert points.size == 2
+    near = points.near(np.array([[0.0, 0.0, 0.3], [3.0, 0.0, 0.0]]), 0.5)
+    assert near.tolist() == [True, False]
+
+
+def test_lidar_returns_attached_to_the_target_join_its_surface() -> None:
+    platform = FakePlatform()
+    track = tracker(platform)
+    target = wall()
+    beside = np.array([[3.0, 2.0 + ATTACHED / 2, 0.5]])  # debris beside the wall
+    far = np.array([[3.0, 8.0, 0.5]])
+    ground = np.array([[3.0, 0.0, 0.05]])  # below min_height
+    platform.scan_points = np.vstack([beside, far, ground])
+    assert len(track.surface(target)) == len(target)  # no scan yet: the mask points only
+    track.ctx.navigator.sense_lidar()
+    track.target_cloud.add(target)
+    surface = track.surface(target)
+    assert len(surface) == len(target) + 1
+    assert np.allclose(surface[-1], beside[0])
+
+
+def test_only_the_surface_up_to_the_top_of_the_view_limits_the_level() -> None:
+    track = tracker()
+    tall = np.vstack([wall(), [[3.0, 0.0, 20.0]]])
+    assert len(track.in_view(tall)) == len(tall) - 1
+    assert len(track.in_view(tall[-1:])) == 1  # nothing below: keep what there is
+
+
+def test_a_step_along_the_surface_keeps_the_viewing_distance() -> None:
+    platform = FakePlatform(position=(0.5, 0.0, 0.7))
+    track = tracker(platform)
+    car = Observation([3.5, 0.0, 0.7], label="car", score=0.9, mask_area=1)
+    track.ctx.graph.register_target(car)
+    track.ctx.graph.optimise_targets()
+    before = platform.position
+    assert track.step_along(wall(), track.ctx.graph.target("car-0"))
+    after = platform.position
+    assert np.linalg.norm(after - before) > MIN_VIEW_STEP
+    assert after[2] == before[2]  # a ground robot keeps its height
+    nearest = np.min(np.linalg.norm(wall()[:, :2] - after[:2], axis=1))
+    assert abs(nearest - 2.5) < 0.5
+
+
+def test_a_view_move_too_short_to_matter_is_refused() -> None:
+    platform = FakePlatform()
+    track = tracker(platform)
+    goal = platform.position + np.array([MIN_VIEW_STEP / 2, 0.0, 0.0])
+    assert not track.move_to_view(goal, 0.0)
+    assert platform.distance_travelled == 0.0
