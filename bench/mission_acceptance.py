@@ -22,7 +22,7 @@ from pathlib import Path
 
 from seminspect.missions.config import make_config, resolve
 from seminspect.missions.run import run_mission
-from seminspect.missions.rundir import read_run_metrics, reusable_run
+from seminspect.missions.rundir import read_metrics_document, reusable_run
 
 CITY = [("city", scenario, seed) for scenario in ("small", "medium", "large") for seed in (0, 1, 2)]
 OTHERS = [
@@ -85,7 +85,7 @@ def main() -> None:
         out = Path(args.out) / name
         reuse = reusable_run(out, config) if args.reuse else None
         if reuse:
-            metrics = read_run_metrics(out).to_json()
+            metrics = read_metrics_document(out)
         else:
             if reuse is not None:
                 print(f"running {name} again: {reuse.reason}", file=sys.stderr, flush=True)

@@ -7,7 +7,7 @@ from seminspect.core.io import read_versioned_json
 from seminspect.mapping.voxel import load_map
 from seminspect.missions.routine import RoutineConfig, _checkpoints
 from seminspect.missions.routine_run import PRIOR_FILE, run_routine
-from seminspect.missions.rundir import read_run_metrics
+from seminspect.missions.rundir import read_metrics_document
 
 SMALL = {"scenario": "receding", "seed": 1, "length": 12.0}
 
@@ -35,7 +35,7 @@ def test_adaptive_run_completes_and_keeps_the_viewing_distance(adaptive):
     assert m["rmse_after_kabsch_m"] < m["rmse_before_kabsch_m"]
     assert m["roi_coverage_pct"] > 50
     assert 0 < m["viewpoint_utility_mean"] <= 1
-    assert read_run_metrics(adaptive.run_dir)["tasks_completed"] == 1
+    assert read_metrics_document(adaptive.run_dir)["tasks_completed"] == 1
 
 
 def test_baseline_tracks_the_outdated_plan_and_sees_less(adaptive, baseline):
@@ -70,7 +70,7 @@ def test_ctrl_c_leaves_a_truthful_run_directory(tmp_path, adaptive):
     )
     status = read_versioned_json(tmp_path / "cut" / "status.json", "seminspect.run-status", [1])
     assert result.state == status["state"] == "interrupted"
-    metrics = read_run_metrics(tmp_path / "cut")
+    metrics = read_metrics_document(tmp_path / "cut")
     assert metrics["tasks_completed"] == 0 and 0 < metrics["cycles"] < adaptive.metrics["cycles"]
 
 

@@ -6,7 +6,7 @@ import shutil
 import pytest
 
 from seminspect.core.errors import FileFormatError, InvalidInputError
-from seminspect.missions.rundir import read_run_metrics
+from seminspect.missions.rundir import read_metrics_document
 from seminspect.missions.sweep import (
     COLUMNS,
     SweepRow,
@@ -65,7 +65,7 @@ def test_a_finished_run_is_reused_and_a_broken_task_is_a_failed_row(
     assert seen == rows
     reused, broken = rows
     assert reused.reused and reused.state == "completed"
-    assert reused.figures == metric_figures(read_run_metrics(small_mission_dir))
+    assert reused.figures == metric_figures(read_metrics_document(small_mission_dir))
     assert reused.figures["inspected_pct"] is not None
     assert broken.state == "failed" and "not a run directory" in broken.error
 

@@ -406,11 +406,14 @@ def read_run_config(run_dir: Path) -> dict[str, Any]:
     return read_versioned_json(run_dir / "config.json", CONFIG_FORMAT, [1])["config"]
 
 
+def read_metrics_document(run_dir: Path) -> dict[str, Any]:
+    """The ``metrics.json`` any run (mission, routine) wrote when it ended, as stored."""
+    return read_versioned_json(run_dir / "metrics.json", METRICS_FORMAT, [1])
+
+
 def read_run_metrics(run_dir: Path) -> MissionMetrics:
-    """The metrics a run wrote when it ended."""
-    return MissionMetrics.from_json(
-        read_versioned_json(run_dir / "metrics.json", METRICS_FORMAT, [1])
-    )
+    """The metrics a mission wrote when it ended."""
+    return MissionMetrics.from_json(read_metrics_document(run_dir))
 
 
 @dataclass(frozen=True)

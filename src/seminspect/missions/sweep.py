@@ -43,7 +43,7 @@ from seminspect.core.io import atomic_write_text, dumps_json, read_yaml
 from seminspect.core.validation import describe_validation_error
 from seminspect.missions.config import MissionConfig, make_config, resolve
 from seminspect.missions.run import run_mission, run_name
-from seminspect.missions.rundir import read_run_metrics, reusable_run
+from seminspect.missions.rundir import read_metrics_document, reusable_run
 
 TABLE_FILES = ("sweep.csv", "sweep.json", "sweep.md")
 #: A grid without scenarios runs each world's default one.
@@ -193,7 +193,7 @@ def run_task(task: SweepTask) -> SweepRow:
     try:
         out = Path(task.run_dir)
         reused = run_or_reuse(MissionConfig.model_validate(task.config), out)
-        metrics = read_run_metrics(out).to_json()
+        metrics = read_metrics_document(out)
         state = str(metrics.get("state", "unknown"))
         row = SweepRow(task.name, task.group, seed, state, reused, figures=metric_figures(metrics))
     except Exception as exc:  # one mission's failure must not stop the sweep

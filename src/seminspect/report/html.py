@@ -39,7 +39,7 @@ from seminspect.graphs.lsg.model import EdgeKind, FeatureNode, Layer, Node, Robo
 from seminspect.graphs.terrain.io import GRAPH_FORMAT as TERRAIN_FORMAT
 from seminspect.graphs.terrain.io import load_terrain_graph
 from seminspect.graphs.terrain.scene_graph import TerrainSceneGraph
-from seminspect.missions.rundir import load_run_world, load_trajectory, read_run_metrics
+from seminspect.missions.rundir import load_run_world, load_trajectory, read_metrics_document
 from seminspect.report.lsg import LAYER_ORDER, layer_heights, lifted_position
 from seminspect.report.run_pictures import load_events, utility_series
 from seminspect.report.terrain import layer_lifts, prompt_colours, subsample_rows
@@ -222,7 +222,7 @@ def path_plot(trajectory: NDArray):
 
 def _metrics_sections(root: Path) -> list[Section]:
     try:
-        metrics = read_run_metrics(root).to_json()
+        metrics = read_metrics_document(root)
     except FileFormatError:
         return [Section("Summary", "<p>This run wrote no metrics (it may have been stopped).</p>")]
     state = f"<p>State: <b>{html.escape(str(metrics.get('state')))}</b> "
