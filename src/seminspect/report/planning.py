@@ -283,20 +283,78 @@ def table5_markdown(runs: Sequence[RunComparison]) -> str:
     return "\n".join(lines)
 
 
+def common_target_rmse(outcomes: Sequence[MissionOutcome], planner: str) -> float | None:
+    """Horizontal RMSE of ``planner``'s missions over the targets that both planners inspected in
+    the same scenario and seed, pooled over the runs: the two planners scored on one target set
+    (each mission's own RMSE covers whatever it inspected within its budget)."""
+    runs = {(o.scenario, o.seed, o.planner): o for o in outcomes}
+    errors = []
+    for (scenario, seed, name), outcome in runs.items():
+        other = runs.get((scenario, seed, _other_planner(name)))
+        if name != planner or other is None:
+            continue
+        shared = outcome.inspected_errors.keys() & other.inspected_errors.keys()
+        errors += [outcome.inspected_errors[truth] for truth in shared]
+    return math.sqrt(statistics.fmean(e * e for e in errors)) if errors else None
+
+
+def _other_planner(planner: str) -> str:
+    return "volumetric" if planner == "hierarchical" else "hierarchical"
+
+
+def _spread(values: Iterable[float | None], digits: int) -> str:
+    """Mean, and the range over the runs in square brackets where they differ."""
+    summary = stats(values)
+    if summary["n"] == 0:
+        return "-"
+    low, high = _num(summary["min"], digits), _num(summary["max"], digits)
+    return _num(summary["mean"], digits) + (f" [{low}-{high}]" if low != high else "")
+
+
+def table6_summary(outcomes: Sequence[MissionOutcome]) -> str:
+    """One row per scenario and planner over the seeds: mean [min-max], the paper's figure in
+    brackets where 000 Table 6 gives one."""
+    lines = [
+        "| Scenario | Planner | seeds | planning load % | CPU load % (paper) "
+        "| coverage m³ (paper) | RMSE m, own targets (paper) | RMSE m, common targets "
+        "| inspected / true | sim s |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    groups: dict[tuple[str, str], list[MissionOutcome]] = {}
+    for o in outcomes:
+        groups.setdefault((o.scenario, o.planner), []).append(o)
+    for (scenario, planner), runs in groups.items():
+        cpu, cover, rmse = PAPER_TABLE6.get(scenario, {}).get(planner, (None, None, None))
+        common = common_target_rmse([o for o in outcomes if o.scenario == scenario], planner)
+        inspected = "; ".join(f"{o.inspected} / {o.true_targets}" for o in runs)
+        lines.append(
+            f"| {scenario} | {planner} | {', '.join(str(o.seed) for o in runs)} "
+            f"| {_spread((o.planning_load_pct for o in runs), 3)} "
+            f"| {_spread((o.cpu_load_pct for o in runs), 1)} ({_num(cpu, 1)}) "
+            f"| {_spread((o.bbox_volume_m3 for o in runs), 1)} ({_num(cover, 1)}) "
+            f"| {_spread((o.rmse_m for o in runs), 3)} ({_num(rmse, 3)}) "
+            f"| {_num(common, 3)} | {inspected} | {_spread((o.sim_time_s for o in runs), 0)} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
 def table6_markdown(outcomes: Sequence[MissionOutcome]) -> str:
     lines = [
         "## Mission-level effect (000 Table 6 analogue; planning time charged to the robot)",
         "",
-        "| Scenario | Planner | CPU load % (paper) | planning load % | coverage m³ (paper) "
-        "| surface coverage % | RMSE m (paper) | inspected / true | sim s | planning wall s "
-        "| route plans |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        table6_summary(outcomes),
+        "Each run:",
+        "",
+        "| Scenario | seed | Planner | CPU load % (paper) | planning load % "
+        "| coverage m³ (paper) | surface coverage % | RMSE m (paper) | inspected / true | sim s "
+        "| planning wall s | route plans |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for o in outcomes:
         paper = PAPER_TABLE6.get(o.scenario, {}).get(o.planner)
         cpu, cover, rmse = paper if paper else (None, None, None)
         lines.append(
-            f"| {o.scenario} | {o.planner} | {_num(o.cpu_load_pct, 1)} ({_num(cpu, 1)}) "
+            f"| {o.scenario} | {o.seed} | {o.planner} | {_num(o.cpu_load_pct, 1)} ({_num(cpu, 1)}) "
             f"| {_num(o.planning_load_pct, 3)} | {_num(o.bbox_volume_m3, 1)} ({_num(cover, 1)}) "
             f"| {_num(o.surface_coverage_pct, 1)} | {_num(o.rmse_m, 3)} ({_num(rmse, 3)}) "
             f"| {o.inspected} / {o.true_targets} | {o.sim_time_s:.0f} | {o.planning_wall_s:.2f} "
