@@ -31,6 +31,7 @@ from seminspect.missions.platform import SimulatedPlatform, mission_noise
 from seminspect.missions.report import summary_markdown
 from seminspect.missions.rundir import RunDirectory
 from seminspect.missions.xflie import MissionProgress, XFlie
+from seminspect.planning.local import warm_up
 from seminspect.worlds import World, generate_world
 
 
@@ -115,6 +116,7 @@ def run_mission(
     run.write_config(config.model_dump(mode="json"))
     run.write_status("running")
     mission, world = build_mission(config, run, progress)
+    warm_up()  # compile before the clock starts: a fresh install times plans, not numba
     cpu = CpuMeter()
     state, reason, error = "completed", "", None
     try:
