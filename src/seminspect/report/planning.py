@@ -255,6 +255,103 @@ def beside_paper(runs: Sequence[RunComparison]) -> list[str]:
     return lines
 
 
+def both_volumes_beside_paper(
+    ground: Sequence[RunComparison], full: Sequence[RunComparison]
+) -> list[str]:
+    """The condensed Table 5 of docs/reproduction.md: per scenario, our medians over the ground
+    band and the full volume (the same queries) beside the paper's."""
+    ours = {run.scenario: run_summary(run) for run in ground}
+    whole = {run.scenario: run_summary(run) for run in full}
+    edges = {run.scenario: dataclasses.asdict(run.edge_check) for run in ground}
+    columns = [s for s in ours if s in PAPER_TABLE5]
+    papers = {s: paper_summary(PAPER_TABLE5[s]) for s in columns}
+    header = " | ".join(
+        f"S{SCENARIO_NUMBER[s]} ours | S{SCENARIO_NUMBER[s]} paper" for s in columns
+    )
+    lines = [
+        f"| Measure (median unless stated) | {header} |",
+        "|---" * (1 + 2 * len(columns)) + "|",
+    ]
+
+    def row(name: str, cell, paper_cell=None) -> None:
+        cells = []
+        for s in columns:
+            cells += [cell(s), paper_cell(s) if paper_cell else "-"]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+
+    def median_min(summaries: dict[str, Any], key: str):
+        return lambda s: (
+            f"{_ratio(summaries[s][key]['median'])} / {_ratio(summaries[s][key]['min'])}"
+        )
+
+    row(
+        "HP Target-layer search (µs)",
+        lambda s: _us(ours[s]["hp_target_layer_s"]["median"]),
+        lambda s: _us(papers[s]["hp_target_layer_s"]["median"]),
+    )
+    row(
+        "HP Pose/Level-layer searches (µs)",
+        lambda s: _us(ours[s]["hp_local_layers_s"]["median"]),
+        lambda s: _us(papers[s]["hp_local_layers_s"]["median"]),
+    )
+    row(
+        "HP end to end: parse, localise, search, waypoints (µs)",
+        lambda s: _us(ours[s]["hp_query_s"]["median"]),
+    )
+    row(
+        "VP at 0.5 m, ground band (ms)",
+        lambda s: _ms(ours[s]["vp_0.5_s"]["median"]),
+        lambda s: _ms(papers[s]["vp_0.5_s"]["median"]),
+    )
+    if whole:
+        row(
+            "VP at 0.5 m, full volume (ms)",
+            lambda s: _ms(whole[s]["vp_0.5_s"]["median"]),
+            lambda s: _ms(papers[s]["vp_0.5_s"]["median"]),
+        )
+    row(
+        "VP at 0.7 m, ground band (ms)",
+        lambda s: _ms(ours[s]["vp_0.7_s"]["median"]),
+        lambda s: _ms(papers[s]["vp_0.7_s"]["median"]),
+    )
+    row(
+        "VP/HP time at 0.5 m, searches, ground (median / min)",
+        median_min(ours, "time_ratio_0.5_search"),
+        median_min(papers, "time_ratio_0.5_search"),
+    )
+    if whole:
+        row(
+            "VP/HP time at 0.5 m, searches, full (median / min)",
+            median_min(whole, "time_ratio_0.5_search"),
+        )
+    row(
+        "VP/HP time at 0.5 m, end to end, ground (median / min)",
+        median_min(ours, "time_ratio_0.5_query"),
+    )
+    row(
+        "HP/VP length at 0.5 m (mean)",
+        lambda s: _num(ours[s]["length_ratio_0.5"]["mean"]),
+        lambda s: _num(papers[s]["length_ratio_0.5"]["mean"]),
+    )
+    row(
+        "refined HP / VP length at 0.5 m (mean)",
+        lambda s: _num(ours[s]["refined_length_ratio_0.5"]["mean"]),
+    )
+    row(
+        "valid segments: graph edges, HP, refined, VP 0.5 m",
+        lambda s: ", ".join(
+            _pct(share)
+            for share in (
+                edges[s],
+                ours[s]["hp_valid_segments"],
+                ours[s]["refined_valid_segments"],
+                ours[s]["vp_0.5_valid_segments"],
+            )
+        ),
+    )
+    return lines  # fmt: skip
+
+
 def table5_markdown(runs: Sequence[RunComparison]) -> str:
     lines = ["## Hierarchical versus volumetric planning (000 Table 5 analogue)", ""]
     for run in runs:
