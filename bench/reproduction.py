@@ -3,9 +3,9 @@
 Each table sits between ``<!-- BEGIN table:NAME -->`` and ``<!-- END table:NAME -->`` in the
 document; the prose and the paper's own rows around them are left as written. Sections:
 
-* ``table3-city``, ``acceptance``, ``table3-others``: 000 Table 3 from the missions of
-  ``bench/mission_acceptance.py`` (city small/medium/large x seeds 0-2; campus, subterranean,
-  both collapsed buildings);
+* ``table3-city-small``, ``-medium``, ``-large``, ``acceptance``, ``table3-others``: 000 Table 3
+  from the missions of ``bench/mission_acceptance.py`` (city small/medium/large x seeds 0-2;
+  campus, subterranean, both collapsed buildings);
 * ``table5``, ``targets``: 000 Table 5 on the city seed-0 runs of the same missions (queries
   answered by both planners, the volumetric one over the ground band and the full volume);
 * ``scaling``: the synthetic-city scaling study (000 Fig 13 analogue);
@@ -36,7 +36,9 @@ from seminspect.report.planning import (
     targets_met,
 )
 
-SECTIONS = ("table3-city", "acceptance", "table3-others", "table5", "targets", "scaling", "table6")
+SCENARIOS = ("small", "medium", "large")
+CITY_SECTIONS = tuple(f"table3-city-{scenario}" for scenario in SCENARIOS)
+SECTIONS = (*CITY_SECTIONS, "acceptance", "table3-others", "table5", "targets", "scaling", "table6")
 DOC = Path(__file__).resolve().parents[1] / "docs" / "reproduction.md"
 
 
@@ -44,31 +46,37 @@ def log(text: str) -> None:
     print(f"[{time.strftime('%H:%M:%S')}] {text}", flush=True)
 
 
+def city_runs(wanted: set[str]) -> list[tuple[str, str | None, int]]:
+    """The city missions the wanted sections need: every seed of a scenario whose rows are
+    wanted (the acceptance list covers those, or every scenario when it is wanted alone), and
+    seed 0 of each for Table 5."""
+    scenarios = {s for s in SCENARIOS if f"table3-city-{s}" in wanted}
+    if "acceptance" in wanted and not scenarios:
+        scenarios = set(SCENARIOS)
+    table5 = bool(wanted & {"table5", "targets"})
+    return [run for run in CITY if run[1] in scenarios or (table5 and run[2] == 0)]
+
+
 def table3_sections(runs_dir: Path, wanted: set[str]) -> tuple[dict[str, str], list[Path]]:
     """The Table 3 sections asked for, and the city seed-0 run directories (for Table 5)."""
-    sections: dict[str, str] = {}
-    if wanted & {"table3-city", "acceptance"}:
-        city = CITY
-    elif wanted & {"table5", "targets"}:
-        city = [run for run in CITY if run[2] == 0]  # Table 5 queries the seed-0 runs
-    else:
-        city = []
     results = []
-    for metrics in run_acceptance(city, runs_dir / "acceptance", reuse=True):
-        log(_name(metrics["run"]))
+    for metrics in run_acceptance(city_runs(wanted), runs_dir / "acceptance", reuse=True):
         results.append(metrics)
-    rows = [row(m["run"]["world"], m["run"]["scenario"], m["run"]["seed"], m) for m in results]
-    sections["table3-city"] = "\n".join([HEADER, *rows])
-    sections["acceptance"] = "\n".join(acceptance_lines(results))
+    sections = {"acceptance": "\n".join(acceptance_lines(results))}
+    for scenario in SCENARIOS:
+        rows = [_row(m) for m in results if m["run"]["scenario"] == scenario]
+        sections[f"table3-city-{scenario}"] = "\n".join([HEADER, *rows])
     if "table3-others" in wanted:
-        others = []
-        for metrics in run_acceptance(OTHERS, runs_dir / "acceptance", reuse=True):
-            log(_name(metrics["run"]))
-            run = metrics["run"]
-            others.append(row(run["world"], run["scenario"], run["seed"], metrics))
-        sections["table3-others"] = "\n".join([HEADER, *others])
+        others = run_acceptance(OTHERS, runs_dir / "acceptance", reuse=True)
+        sections["table3-others"] = "\n".join([HEADER, *(_row(m) for m in others)])
     seed0 = [runs_dir / "acceptance" / _name(m["run"]) for m in results if m["run"]["seed"] == 0]
     return {k: v for k, v in sections.items() if k in wanted}, seed0
+
+
+def _row(metrics: dict) -> str:
+    run = metrics["run"]
+    log(_name(run))
+    return row(run["world"], run["scenario"], run["seed"], metrics)
 
 
 def _name(run: dict) -> str:
