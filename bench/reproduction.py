@@ -83,8 +83,11 @@ def _name(run: dict) -> str:
     return f"{run['world']}-{run['scenario'] or 'default'}-seed{run['seed']}"
 
 
-def planning_sections(runs_dir: Path, seed0_runs: list[Path], wanted: set[str]) -> dict[str, str]:
-    """Table 5 (both volumes) on the city seed-0 runs, the scaling study and Table 6."""
+def planning_sections(
+    runs_dir: Path, seed0_runs: list[Path], wanted: set[str], table6_scenarios: list[str]
+) -> dict[str, str]:
+    """Table 5 (both volumes) on the city seed-0 runs, the scaling study and Table 6 (over
+    ``table6_scenarios``)."""
     sections: dict[str, str] = {}
     ground, full = [], []
     if wanted & {"table5", "targets"}:
@@ -104,9 +107,7 @@ def planning_sections(runs_dir: Path, seed0_runs: list[Path], wanted: set[str]) 
     if "scaling" in wanted:
         sections["scaling"] = scaling_markdown(scaling).split("\n", 2)[2]
     if "table6" in wanted:
-        outcomes = mission_study(
-            ("small", "medium", "large"), runs_dir / "planning", progress=_table6_log
-        )
+        outcomes = mission_study(table6_scenarios, runs_dir / "planning", progress=_table6_log)
         sections["table6"] = table6_summary(outcomes)
     return sections
 
@@ -119,19 +120,30 @@ def _table6_log(label: str, mission: object) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--doc", type=Path, default=DOC, help="the Markdown file to rewrite")
-    parser.add_argument("--runs", type=Path, default=Path("runs/reproduction"))
+    parser.add_argument(
+        "--runs",
+        type=Path,
+        default=Path("runs/reproduction"),
+        help="where the mission runs go; complete runs of the same configuration are reused",
+    )
     parser.add_argument(
         "--only", action="append", choices=SECTIONS, help="regenerate this section (repeatable)"
     )
     parser.add_argument(
         "--fresh", action="store_true", help="delete the run directories under --runs first"
     )
+    parser.add_argument(
+        "--table6-scenario",
+        action="append",
+        choices=SCENARIOS,
+        help="city scenario of Table 6 (repeatable; default: all three)",
+    )
     args = parser.parse_args()
     wanted = set(args.only or SECTIONS)
     if args.fresh and args.runs.exists():
         shutil.rmtree(args.runs)
     sections, seed0 = table3_sections(args.runs, wanted)
-    sections |= planning_sections(args.runs, seed0, wanted)
+    sections |= planning_sections(args.runs, seed0, wanted, args.table6_scenario or list(SCENARIOS))
     rewrite_sections(args.doc, sections)
     log(f"rewrote {', '.join(sorted(sections))} in {args.doc}")
 
