@@ -273,83 +273,49 @@ def both_volumes_beside_paper(
         "|---" * (1 + 2 * len(columns)) + "|",
     ]
 
-    def row(name: str, cell, paper_cell=None) -> None:
+    def row(name: str, our_cell, paper_cell=None) -> None:
         cells = []
         for s in columns:
-            cells += [cell(s), paper_cell(s) if paper_cell else "-"]
+            cells += [our_cell(s), paper_cell(s) if paper_cell else "-"]
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
+
+    def cell(summaries: dict[str, Any], key: str, fmt, stat: str = "median"):
+        return lambda s: fmt(summaries[s][key][stat])
 
     def median_min(summaries: dict[str, Any], key: str):
         return lambda s: (
             f"{_ratio(summaries[s][key]['median'])} / {_ratio(summaries[s][key]['min'])}"
         )
 
-    row(
-        "HP Target-layer search (µs)",
-        lambda s: _us(ours[s]["hp_target_layer_s"]["median"]),
-        lambda s: _us(papers[s]["hp_target_layer_s"]["median"]),
-    )
-    row(
-        "HP Pose/Level-layer searches (µs)",
-        lambda s: _us(ours[s]["hp_local_layers_s"]["median"]),
-        lambda s: _us(papers[s]["hp_local_layers_s"]["median"]),
-    )
-    row(
-        "HP end to end: parse, localise, search, waypoints (µs)",
-        lambda s: _us(ours[s]["hp_query_s"]["median"]),
-    )
-    row(
-        "VP at 0.5 m, ground band (ms)",
-        lambda s: _ms(ours[s]["vp_0.5_s"]["median"]),
-        lambda s: _ms(papers[s]["vp_0.5_s"]["median"]),
-    )
+    both, search = (ours, papers), "time_ratio_0.5_search"
+    row("HP Target-layer search (µs)", *(cell(x, "hp_target_layer_s", _us) for x in both))
+    row("HP Pose/Level-layer searches (µs)", *(cell(x, "hp_local_layers_s", _us) for x in both))
+    row("HP end to end: parse, localise, search, waypoints (µs)", cell(ours, "hp_query_s", _us))
+    row("VP at 0.5 m, ground band (ms)", *(cell(x, "vp_0.5_s", _ms) for x in both))
     if whole:
-        row(
-            "VP at 0.5 m, full volume (ms)",
-            lambda s: _ms(whole[s]["vp_0.5_s"]["median"]),
-            lambda s: _ms(papers[s]["vp_0.5_s"]["median"]),
-        )
-    row(
-        "VP at 0.7 m, ground band (ms)",
-        lambda s: _ms(ours[s]["vp_0.7_s"]["median"]),
-        lambda s: _ms(papers[s]["vp_0.7_s"]["median"]),
-    )
+        row("VP at 0.5 m, full volume (ms)", *(cell(x, "vp_0.5_s", _ms) for x in (whole, papers)))
+    row("VP at 0.7 m, ground band (ms)", *(cell(x, "vp_0.7_s", _ms) for x in both))
     row(
         "VP/HP time at 0.5 m, searches, ground (median / min)",
-        median_min(ours, "time_ratio_0.5_search"),
-        median_min(papers, "time_ratio_0.5_search"),
+        *(median_min(x, search) for x in both),
     )
     if whole:
-        row(
-            "VP/HP time at 0.5 m, searches, full (median / min)",
-            median_min(whole, "time_ratio_0.5_search"),
-        )
+        row("VP/HP time at 0.5 m, searches, full (median / min)", median_min(whole, search))
     row(
         "VP/HP time at 0.5 m, end to end, ground (median / min)",
         median_min(ours, "time_ratio_0.5_query"),
     )
-    row(
-        "HP/VP length at 0.5 m (mean)",
-        lambda s: _num(ours[s]["length_ratio_0.5"]["mean"]),
-        lambda s: _num(papers[s]["length_ratio_0.5"]["mean"]),
-    )
+    row("HP/VP length at 0.5 m (mean)", *(cell(x, "length_ratio_0.5", _num, "mean") for x in both))
     row(
         "refined HP / VP length at 0.5 m (mean)",
-        lambda s: _num(ours[s]["refined_length_ratio_0.5"]["mean"]),
+        cell(ours, "refined_length_ratio_0.5", _num, "mean"),
     )
+    checks = ("hp_valid_segments", "refined_valid_segments", "vp_0.5_valid_segments")
     row(
         "valid segments: graph edges, HP, refined, VP 0.5 m",
-        lambda s: ", ".join(
-            _pct(share)
-            for share in (
-                edges[s],
-                ours[s]["hp_valid_segments"],
-                ours[s]["refined_valid_segments"],
-                ours[s]["vp_0.5_valid_segments"],
-            )
-        ),
+        lambda s: ", ".join(_pct(share) for share in (edges[s], *(ours[s][k] for k in checks))),
     )
-    return lines  # fmt: skip
+    return lines
 
 
 def table5_markdown(runs: Sequence[RunComparison]) -> str:
