@@ -1,22 +1,27 @@
-# Two entry points for a fresh machine; each builds the virtual environment it needs.
-#   make mission   install seminspect and run the default inspection mission
-#   make test      install seminspect with test tools and run the test suite
+# Entry points for a fresh machine; each builds the virtual environment it needs.
+#   make mission     install seminspect and run the default inspection mission
+#   make test        install seminspect with test tools and run the test suite
+#   make reproduce   regenerate every measured table of docs/reproduction.md (hours)
+#   make lock        rewrite requirements.lock from the versions installed in .venv
+# Installs take the exact versions of requirements.lock (the ones behind the published
+# figures); pyproject.toml keeps version ranges for people who use seminspect as a library.
 PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
+LOCK := requirements.lock
 
-.PHONY: mission test lint bench clean
+.PHONY: mission test lint bench reproduce lock clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 
-$(VENV)/.installed-run: pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e .
+$(VENV)/.installed-run: pyproject.toml $(LOCK) | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -c $(LOCK) -e .
 	touch $@
 
-$(VENV)/.installed-test: pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e '.[test]'
+$(VENV)/.installed-test: pyproject.toml $(LOCK) | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -c $(LOCK) -e '.[test]'
 	touch $@ $(VENV)/.installed-run
 
 mission: $(VENV)/.installed-run
@@ -28,6 +33,15 @@ test: $(VENV)/.installed-test
 lint: $(VENV)/.installed-test
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
+
+reproduce: $(VENV)/.installed-test
+	$(BIN)/python bench/reproduction.py --fresh
+
+# After changing a dependency in pyproject.toml: install the new version in .venv, then lock.
+lock: | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e '.[test]'
+	$(BIN)/python scripts/lock_requirements.py
+	touch $(VENV)/.installed-test $(VENV)/.installed-run
 
 clean:
 	rm -rf $(VENV) runs .pytest_cache .ruff_cache

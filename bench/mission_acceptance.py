@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 from seminspect.missions.config import make_config, resolve
@@ -48,8 +49,9 @@ def row(world: str, scenario: str | None, seed: int, metrics: dict) -> str:
     t3, t6, m = metrics["table3"], metrics["table6"], metrics["mission"]
     pops = " ".join("/".join(map(str, t3[k])) for k in ("target", "level", "pose", "feature"))
     rmse = t6["localisation_rmse_m"]
+    name = " ".join(filter(None, (world, scenario)))
     return (
-        f"| {world} {scenario or ''} | {seed} | {pops} | {'/'.join(map(str, t3['unified']))} "
+        f"| {name} | {seed} | {pops} | {'/'.join(map(str, t3['unified']))} "
         f"| {t3['reconciled_pct']:.1f} | {t3['detected_pct']:.0f}/{t3['inspected_pct']:.0f} "
         f"| {metrics['targets']['false_targets']} | {'-' if rmse is None else f'{rmse:.3f}'} "
         f"| {_f(t6['surface_coverage_pct'], 1)} | {t6['bbox_volume_m3']:.0f} "
@@ -62,6 +64,58 @@ def _f(value: float | None, digits: int) -> str:
     return "-" if value is None else f"{value:.{digits}f}"
 
 
+HEADER = (
+    "| run | seed | Target Level Pose Feature | Unified | Reconciled % | Detected/Inspected % "
+    "| false targets | RMSE xy (m) | surface coverage % | box volume (m^3) | collisions "
+    "| levels by eq 8 / cap | sim s | x real time |\n" + "|" + "---|" * 14
+)
+
+
+def run_acceptance(
+    runs: list[tuple[str, str | None, int]], out_dir: Path, *, reuse: bool
+) -> Iterator[dict]:
+    """Each run's metrics (tagged with its world, scenario and seed), run or read from
+    ``out_dir`` when ``reuse`` and a completed run of the same configuration is there."""
+    for world, scenario, seed in runs:
+        config = resolve(make_config({"world": world, "scenario": scenario, "seed": seed}))
+        out = out_dir / f"{world}-{scenario or 'default'}-seed{seed}"
+        reused = reusable_run(out, config) if reuse else None
+        if reused:
+            metrics = read_metrics_document(out)
+        else:
+            if reused is not None:
+                print(f"running {out.name} again: {reused.reason}", file=sys.stderr, flush=True)
+            metrics = run_mission(config, out).metrics.to_json()
+        yield {**metrics, "run": {"world": world, "scenario": scenario, "seed": seed}}
+
+
+def acceptance_lines(results: list[dict]) -> list[str]:
+    """Issue 4's acceptance figures per city scenario, the paper's beside them."""
+    lines = []
+    for scenario in ("small", "medium", "large"):
+        group = [
+            r for r in results if r["run"]["world"] == "city" and r["run"]["scenario"] == scenario
+        ]
+        if not group:
+            continue
+        detected = min(r["table3"]["detected_pct"] for r in group)
+        inspected = min(r["table3"]["inspected_pct"] for r in group)
+        rmse = max(r["table6"]["localisation_rmse_m"] or 0.0 for r in group)
+        populated = all(
+            min(min(r["table3"][k]) for k in ("target", "level", "pose", "feature")) > 0
+            for r in group
+        )
+        collisions = sum(r["mission"]["collisions"] for r in group)
+        paper = PAPER[scenario]
+        lines.append(
+            f"- {scenario} ({len(group)} seeds): detected >= {detected:.0f} %, inspected >= "
+            f"{inspected:.0f} %, worst RMSE {rmse:.3f} m, every layer populated: {populated}, "
+            f"collisions {collisions}; paper: {paper['det']} %, RMSE {paper['rmse']} m, "
+            f"Table 3 {paper['t3']}"
+        )
+    return lines
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", default="runs/acceptance", help="where the run directories go")
@@ -72,45 +126,15 @@ def main() -> None:
     )
     args = parser.parse_args()
     runs = CITY + ([] if args.city_only else OTHERS)
-    print(
-        "| run | seed | Target Level Pose Feature | Unified | Reconciled % | Detected/Inspected % "
-        "| false targets | RMSE xy (m) | surface coverage % | box volume (m^3) | collisions "
-        "| levels by eq 8 / cap | sim s | x real time |"
-    )
-    print("|" + "---|" * 14)
+    print(HEADER)
     results = []
-    for world, scenario, seed in runs:
-        name = f"{world}-{scenario or 'default'}-seed{seed}"
-        config = resolve(make_config({"world": world, "scenario": scenario, "seed": seed}))
-        out = Path(args.out) / name
-        reuse = reusable_run(out, config) if args.reuse else None
-        if reuse:
-            metrics = read_metrics_document(out)
-        else:
-            if reuse is not None:
-                print(f"running {name} again: {reuse.reason}", file=sys.stderr, flush=True)
-            metrics = run_mission(config, out).metrics.to_json()
-        results.append({**metrics, "run": {"world": world, "scenario": scenario, "seed": seed}})
-        print(row(world, scenario, seed, metrics), flush=True)
-    city = [r for r in results if r["run"]["world"] == "city"]
+    for metrics in run_acceptance(runs, Path(args.out), reuse=args.reuse):
+        results.append(metrics)
+        run = metrics["run"]
+        print(row(run["world"], run["scenario"], run["seed"], metrics), flush=True)
     print()
     print("City acceptance (issue 4): ")
-    for scenario in ("small", "medium", "large"):
-        group = [r for r in city if r["run"]["scenario"] == scenario]
-        detected = min(r["table3"]["detected_pct"] for r in group)
-        inspected = min(r["table3"]["inspected_pct"] for r in group)
-        rmse = max(r["table6"]["localisation_rmse_m"] or 0.0 for r in group)
-        populated = all(
-            min(min(r["table3"][k]) for k in ("target", "level", "pose", "feature")) > 0
-            for r in group
-        )
-        collisions = sum(r["mission"]["collisions"] for r in group)
-        paper = PAPER[scenario]
-        print(
-            f"- {scenario}: detected >= {detected:.0f} %, inspected >= {inspected:.0f} %, "
-            f"worst RMSE {rmse:.3f} m, every layer populated: {populated}, collisions "
-            f"{collisions}; paper: {paper['det']} %, RMSE {paper['rmse']} m, Table 3 {paper['t3']}"
-        )
+    print("\n".join(acceptance_lines(results)))
     if args.json:
         Path(args.json).write_text(json.dumps(results, indent=1), encoding="utf-8")
 

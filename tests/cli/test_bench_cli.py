@@ -19,12 +19,12 @@ def test_the_planning_study_writes_its_tables_figure_and_json(capsys, tmp_path, 
     out = tmp_path / "bench"
     code, text, _ = run(
         capsys, "bench", "planning", "-s", "large", "-s", "large", "--out", str(out),
-        "--size", "50", "--size", "20", "--no-missions", "--volume", "full",
+        "--size", "50", "--size", "20", "--no-missions", "--volume", "full", "--seeds", "2",
     )  # fmt: skip
     assert code == 0
     assert calls["scenarios"] == ["large"] and calls["runs_dir"] == out / "runs"
     assert calls["sizes"] == [20, 50] and calls["missions"] is False and calls["queries"] == 9
-    assert calls["volume"] == "full"
+    assert calls["volume"] == "full" and calls["seeds"] == [0, 1]
     for name in ("planning.md", "planning.json", "scaling.png"):
         assert (out / name).stat().st_size > 0 and str(out / name) in text
 
@@ -36,6 +36,7 @@ def test_the_planning_study_writes_its_tables_figure_and_json(capsys, tmp_path, 
         (("--queries", "0"), "--queries"),
         (("--size", "1"), "at least 2 vehicles"),
         (("--volume", "sky"), "'sky' is not one of"),
+        (("--seeds", "0"), "--seeds"),
     ],
 )
 def test_bad_study_settings_exit_non_zero_with_one_line(capsys, tmp_path, args, message) -> None:

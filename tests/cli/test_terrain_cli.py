@@ -111,3 +111,22 @@ def test_a_bag_becomes_a_cloud_and_then_a_graph(capsys, tmp_path, labelled_scene
         str(tmp_path / "other.npz"),
     )  # fmt: skip
     assert code == 1 and "no topic '/points'" in err and len(err.strip().splitlines()) == 1
+
+
+def test_kitti_prompts_are_scored_against_the_class_they_name(
+    capsys, tmp_path, shared_data, fake_encoder
+) -> None:
+    root = shared_data / "semantickitti/seq00_frames000-002"
+    out = tmp_path / "kitti"
+    code, _, err = run(
+        capsys, "terrain", "graph", str(root / "velodyne/000000.bin"), "--labels",
+        str(root / "labels/000000.label"), "--encoder", "hashing-test", "--terrain", "sidewalk",
+        "--objects", "trunk,image of a car", "--evaluate", "--out", str(out),
+    )  # fmt: skip
+    assert code == 0, err
+    quality = json.loads((out / "summary.json").read_text())["quality"]
+    trunk, car = quality["trunk"], quality["image of a car"]
+    assert (trunk["ground_truth_class"], trunk["class_chosen_by"]) == ("trunk", "name")
+    assert "no instances of 'trunk'" in trunk["unscored"] and "precision" not in trunk
+    assert (car["ground_truth_class"], car["class_chosen_by"]) == ("car", "name")
+    assert car["ground_truth"] > 5 and 0 < car["class_similarity"] <= 1.0

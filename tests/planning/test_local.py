@@ -3,8 +3,9 @@ import pytest
 
 from seminspect.core.errors import InvalidInputError, PlanningError
 from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap
+from seminspect.planning import grid_search, gridmap, smoothing
 from seminspect.planning.gridmap import CostGrid, CostModel
-from seminspect.planning.local import LocalPlanner
+from seminspect.planning.local import LocalPlanner, warm_up
 from seminspect.planning.volumetric import VolumetricPlanner
 
 
@@ -92,3 +93,26 @@ def test_bad_settings_are_refused() -> None:
         LocalPlanner(CostModel(0.3), mode="boat")
     with pytest.raises(InvalidInputError, match="heuristic_weight"):
         LocalPlanner(CostModel(0.3), heuristic_weight=0.5)
+
+
+def _compiled_signatures() -> dict[str, int]:
+    from numba.core.registry import CPUDispatcher
+
+    return {
+        f"{module.__name__}.{name}": len(kernel.signatures)
+        for module in (grid_search, gridmap, smoothing)
+        for name, kernel in vars(module).items()
+        if isinstance(kernel, CPUDispatcher)
+    }
+
+
+def test_the_warm_up_compiles_every_kernel_a_mission_plan_needs() -> None:
+    assert warm_up() > 0
+    compiled = _compiled_signatures()
+    assert sum(compiled.values()) >= 3
+    # plans of both modes, into unknown space and on known space only, compile nothing more
+    for unknown_cost in (1.0, None):
+        for mode in ("ground", "aerial"):
+            planner = LocalPlanner(CostModel(0.4, unknown_cost=unknown_cost), mode=mode)
+            planner.plan(_robot_map(), [2.0, 2.0, 1.0], [35.0 if unknown_cost else 20.0, 3.0, 1.0])
+    assert _compiled_signatures() == compiled

@@ -48,6 +48,9 @@ def planning(
     missions: bool = typer.Option(
         True, "--missions/--no-missions", help="Run the Table 6 mission comparison."
     ),
+    seeds: int = typer.Option(
+        3, "--seeds", min=1, help="Seeds of each Table 6 mission (0, 1, ...); mean and spread."
+    ),
     volume: VolumeChoice = typer.Option(
         VolumeChoice.ground,
         "--volume",
@@ -72,7 +75,7 @@ def planning(
     if any(n < 2 for n in sizes):
         raise typer.BadParameter("city sizes must be at least 2 vehicles", param_hint="--size")
     names = list(dict.fromkeys(s.value for s in scenario))
-    steps = len(names) * (1 + queries) + len(sizes) + (2 * len(names) if missions else 0)
+    steps = len(names) * (1 + queries) + len(sizes) + (2 * len(names) * seeds if missions else 0)
     columns = (
         TextColumn("[bold]{task.description}"),
         BarColumn(),
@@ -98,6 +101,7 @@ def planning(
             missions=missions,
             volume=volume.value,
             progress=show,
+            seeds=list(range(seeds)),
         )
     written = write_study(study, out)
     for kind, path in written.items():

@@ -104,23 +104,37 @@ def _encoder(name: str, noise: float, seed: int):
 
 
 def _kitti_quality(build, fused, encoder) -> dict[str, Any]:
-    """Object precision/recall against the scans' own instance labels."""
-    from seminspect.graphs.terrain.evaluate import closest_class, match_boxes, predicted_boxes
+    """Object precision/recall against the scans' own instance labels.
+
+    A prompt is matched against every class of the label table, so 'trunk' is the trunk class;
+    only SemanticKITTI's "things" carry instance ids, and a prompt naming any other class is
+    reported unscored rather than scored against the nearest thing.
+    """
+    from seminspect.graphs.terrain.evaluate import match_boxes, match_class, predicted_boxes
     from seminspect.mapping.semantickitti import instance_boxes, label_table
 
-    things = label_table().thing_classes()
-    ids = {name: label for label, name in things.items()}
+    table = label_table()
+    things = table.thing_classes()
+    # every label name whose points train as a thing ('moving-car' is a car) -> that class id
+    ids = {
+        name: table.learning_map[raw]
+        for raw, name in table.names.items()
+        if table.learning_map[raw] in things
+    }
+    classes = sorted(set(table.names.values()))
     report: dict[str, Any] = {}
     for prompt in build.scene.prompts.objects:
-        truth = closest_class(encoder, prompt, list(ids), build.scene.calibration.objects)
-        if truth is None:
-            report[prompt] = {"ground_truth_class": None}
+        match = match_class(encoder, prompt, classes, build.scene.calibration.objects)
+        report[prompt] = match.as_dict()
+        if match.truth not in ids:
+            if match.truth is not None:
+                report[prompt]["unscored"] = f"SemanticKITTI has no instances of {match.truth!r}"
             continue
         boxes = instance_boxes(
-            fused.points, fused.semantic, fused.instance, ids[truth], min_points=1
+            fused.points, fused.semantic, fused.instance, ids[match.truth], min_points=1
         )
         scores = match_boxes(predicted_boxes(build.scene, prompt), boxes, threshold=0.3)
-        report[prompt] = {"ground_truth_class": truth, **scores.as_dict()}
+        report[prompt].update(scores.as_dict())
     return report
 
 

@@ -42,6 +42,7 @@ from seminspect.missions.platform import SimulatedPlatform, mission_noise
 from seminspect.missions.rundir import OUTPUT_FILES, RunDirectory, RunEnd, conduct_run
 from seminspect.missions.summary import summary_markdown
 from seminspect.missions.xflie import MissionProgress, XFlie
+from seminspect.planning.local import warm_up
 from seminspect.worlds import World, open_world
 from seminspect.worlds.catalog import is_world_path
 
@@ -134,6 +135,7 @@ def _run(
     progress: Callable[[MissionProgress], None] | None,
 ) -> MissionResult:
     mission, world = build_mission(config, run, progress, world)
+    warm_up()  # compile before the clock starts: a fresh install times plans, not numba
     cpu = CpuMeter()
     answers: list[QueryAnswer] = []
     metrics: MissionMetrics | None = None

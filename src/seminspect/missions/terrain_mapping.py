@@ -40,8 +40,8 @@ from seminspect.core.errors import InvalidInputError, PlanningError
 from seminspect.core.validation import build
 from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.graphs.terrain.evaluate import (
-    closest_class,
     match_boxes,
+    match_class,
     predicted_boxes,
     score_places,
 )
@@ -324,21 +324,21 @@ def evaluate_on_world(
     objects: dict[str, Any] = {}
     object_classes = sorted({info.class_name for info in world.instances.values()})
     for prompt in scene.prompts.objects:
-        truth = closest_class(encoder, prompt, object_classes, scene.calibration.objects)
-        boxes = truth_boxes(world, truth) if truth else []
+        match = match_class(encoder, prompt, object_classes, scene.calibration.objects)
+        boxes = truth_boxes(world, match.truth) if match.truth else []
         scores = match_boxes(predicted_boxes(scene, prompt), boxes, iou)
-        objects[prompt] = {"ground_truth_class": truth, **scores.as_dict()}
+        objects[prompt] = {**match.as_dict(), **scores.as_dict()}
     patches = terrain_patches(world)
     terrain_classes = sorted({cls for cls, _ in patches})
     places: dict[str, Any] = {}
     for prompt in scene.prompts.terrain:
-        truth = closest_class(encoder, prompt, terrain_classes, scene.calibration.terrain)
-        mine = [polygon for cls, polygon in patches if cls == truth]
+        match = match_class(encoder, prompt, terrain_classes, scene.calibration.terrain)
+        mine = [polygon for cls, polygon in patches if cls == match.truth]
         place_scores = score_places(
             scene, prompt, mine, min_area=min_patch_area, tolerance=scene.params.cell_size
         )
         places[prompt] = {
-            "ground_truth_class": truth,
+            **match.as_dict(),
             "points_on_terrain": _points_on(scene.layer1, prompt, mine),
             **place_scores.as_dict(),
         }

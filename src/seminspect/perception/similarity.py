@@ -23,11 +23,13 @@ from numpy.typing import NDArray
 
 from seminspect.core.errors import InvalidInputError
 
-#: Γ_thresh for this matcher. 000 Table 1's 0.3 (0.4 for collapsed buildings) is calibrated
-#: for LightGlue, which matches across large viewpoint changes. Measured on simulated vehicle
-#: inspections (campus, 3 cars, ``docs/reproduction.md``): views within 0.7 m and 7 degrees of
-#: a level's first images score Γ = 0.07-0.15 against them; every view farther than 3 m scores
-#: at most 0.031 (95th percentile 0.024). 0.07 separates the two with a 2x margin.
+#: Γ_thresh for this matcher, in both presets. 000 Table 1's 0.3 (0.4 for collapsed buildings)
+#: is calibrated for LightGlue, which matches across large viewpoint changes. Calibrated by
+#: ``bench/similarity_calibration.py`` (city small and collapsed fire station, seeds 0-2; table
+#: in ``docs/reproduction.md``): views 3 m or more from a level's first images score at most
+#: 0.030 (city) and 0.042 (collapsed), a margin of 1.7x or more; views closing the ring score
+#: 0.21-0.95 among collapsed buildings and have medians 0.18-0.25 in the city, 7-23 % of them
+#: below 0.07 (each such miss costs one more view).
 ORB_GAMMA_THRESHOLD = 0.07
 
 

@@ -7,7 +7,7 @@ import pytest
 import shapely
 
 from seminspect.core.errors import FileFormatError, InvalidInputError, PlanningError
-from seminspect.graphs.terrain.evaluate import closest_class, score_places
+from seminspect.graphs.terrain.evaluate import score_places
 from seminspect.graphs.terrain.io import (
     load_terrain_graph,
     save_terrain_graph,
@@ -143,11 +143,3 @@ def test_places_are_scored_against_true_patches(build) -> None:
     absent = score_places(scene, "sidewalk", [])
     assert absent.patches == 0 and absent.off_terrain == len(mine)
     assert absent.as_dict()["worst_offset"] is None  # infinite: no such terrain at all
-
-
-def test_prompts_meet_truth_classes_through_their_captions(fake_encoder) -> None:
-    classes = ["tree", "car", "grass"]
-    assert closest_class(fake_encoder, "image of a car", classes, 0.45) == "car"
-    assert closest_class(fake_encoder, "lawn", classes, 0.45) == "grass"  # a synonym
-    assert closest_class(fake_encoder, "image of a boat", classes, 0.45) is None
-    assert closest_class(fake_encoder, "image of a car", [], 0.45) is None

@@ -122,6 +122,7 @@ def test_table_6_runs_charge_planning_under_the_papers_budget() -> None:
     assert study_config("large").time_budget_s == 3600.0  # the mission default
     table6 = study_config("large", "volumetric", table6=True)
     assert table6.time_budget_s == 2800.0 and table6.charge_planning_time
+    assert study_config("medium", table6=True, seed=2).seed == 2
     with pytest.raises(InvalidInputError, match="unknown city scenario 'huge'"):
         study_config("huge")
 
@@ -169,6 +170,8 @@ def test_an_unknown_volume_is_refused(small_mission_dir: Path) -> None:
 def test_mission_outcomes_are_read_from_the_metrics(small_mission_dir: Path) -> None:
     outcome = MissionOutcome.read(small_mission_dir, "small", "hierarchical")
     assert outcome.inspected >= 3 and outcome.sim_time_s > 0 and outcome.planning_wall_s > 0
+    assert outcome.seed == 0 and len(outcome.inspected_errors) == outcome.inspected
+    assert max(outcome.inspected_errors.values()) < 1.0
     assert outcome.planning_load_pct == pytest.approx(
         100 * outcome.planning_wall_s / outcome.sim_time_s
     )

@@ -3,15 +3,20 @@
 - Objects: predicted boxes matched one-to-one with true boxes; precision and recall at a box IoU.
 - Places: for each true patch of a terrain, whether its places form one connected GVD graph,
   and whether any place lies off every patch of its terrain.
-- Prompts meet ground-truth class names through the encoder: a prompt scores against the class
-  whose caption it is most similar to, when that similarity reaches the prompt's threshold.
+- A prompt is scored against the ground-truth class it names: a class whose name it is (after
+  dropping "image of a"), else the one class it names by a synonym of the caption vocabulary,
+  else the class whose caption the encoder finds most similar, when that similarity reaches the
+  prompt's threshold. Text similarity alone would score 'trunk' against whatever caption its
+  embedding happens to sit nearest; the chosen class, how it was chosen and its similarity are
+  reported beside the scores.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import re
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass
-from typing import Any
+from typing import Any, Literal
 
 import networkx as nx
 import numpy as np
@@ -22,7 +27,7 @@ from shapely.geometry import Polygon
 
 from seminspect.core.io import finite_or_none
 from seminspect.graphs.terrain.scene_graph import TerrainSceneGraph
-from seminspect.perception.encoders import TextEncoder, caption
+from seminspect.perception.encoders import DEFAULT_SYNONYMS, TextEncoder, caption
 
 Box = tuple[NDArray[np.float64], NDArray[np.float64]]
 
@@ -87,16 +92,68 @@ def predicted_boxes(scene: TerrainSceneGraph, prompt: str) -> list[Box]:
     ]
 
 
-def closest_class(
-    encoder: TextEncoder, prompt: str, classes: Sequence[str], threshold: float
-) -> str | None:
-    """The class whose caption is most similar to ``prompt``, or ``None`` below ``threshold``."""
+#: Words around an object prompt that name no class ("image of a tree").
+_PROMPT_FILLER = re.compile(r"^(an? )?(image|photo|picture) of (an? |the )?")
+
+
+def prompt_name(prompt: str) -> str:
+    """The class name a prompt spells: lower case, filler dropped, dashes as spaces."""
+    words = " ".join(prompt.lower().replace("-", " ").replace("_", " ").split())
+    return _PROMPT_FILLER.sub("", words)
+
+
+@dataclass(frozen=True)
+class ClassMatch:
+    """The ground-truth class a prompt is scored against, and how it was chosen.
+
+    Attributes:
+        truth: the class, or ``None`` when the prompt names none and no caption is similar
+            enough.
+        by: ``"name"`` (the prompt is the class's name), ``"alias"`` (a synonym of exactly one
+            class), ``"similarity"`` (the most similar caption) or ``"none"``.
+        similarity: cosine similarity of the prompt to the chosen (or, for ``"none"``, the most
+            similar) class's caption; ``None`` without classes.
+    """
+
+    truth: str | None
+    by: Literal["name", "alias", "similarity", "none"]
+    similarity: float | None
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "ground_truth_class": self.truth,
+            "class_chosen_by": self.by,
+            "class_similarity": self.similarity,
+        }
+
+
+def match_class(
+    encoder: TextEncoder,
+    prompt: str,
+    classes: Sequence[str],
+    threshold: float,
+    synonyms: Mapping[str, Sequence[str]] = DEFAULT_SYNONYMS,
+) -> ClassMatch:
+    """The class of ``classes`` that ``prompt`` names: by name, by one class's synonym, or by
+    caption similarity of at least ``threshold`` (see the module docstring)."""
     if not classes:
-        return None
-    captions = encoder.encode_text([caption(name) for name in classes])
+        return ClassMatch(None, "none", None)
+    captions = encoder.encode_text([caption(name, synonyms) for name in classes])
     similarity = captions @ encoder.encode_text([prompt])[0]
-    best = int(np.argmax(similarity))
-    return classes[best] if similarity[best] >= threshold else None
+    name = prompt_name(prompt)
+    by: Literal["name", "alias", "similarity", "none"]
+    named = [i for i, c in enumerate(classes) if c.replace("-", " ") == name]
+    aliased = [i for i, c in enumerate(classes) if name in synonyms.get(c, ())]
+    if named:
+        best, by = named[0], "name"
+    elif len(aliased) == 1:
+        best, by = aliased[0], "alias"
+    else:  # among the classes a shared synonym names, or all of them
+        candidates = aliased or range(len(classes))
+        best = max(candidates, key=lambda i: float(similarity[i]))
+        by = "similarity" if similarity[best] >= threshold else "none"
+    score = float(similarity[best])
+    return ClassMatch(classes[best] if by != "none" else None, by, score)
 
 
 @dataclass(frozen=True)

@@ -39,7 +39,7 @@ SCENARIO_NUMBER = {"small": 1, "medium": 2, "large": 3}
 
 
 # ---------------------------------------------------------------------------- aggregates
-def stats(values: Iterable[float]) -> dict[str, float | int | None]:
+def stats(values: Iterable[float | None]) -> dict[str, float | int | None]:
     """Median, mean, minimum and maximum of the finite values (``None`` when there are none)."""
     finite = [v for v in values if v is not None and math.isfinite(v)]
     if not finite:
@@ -209,6 +209,69 @@ def beside_paper(runs: Sequence[RunComparison]) -> list[str]:
     return lines
 
 
+def both_volumes_beside_paper(
+    ground: Sequence[RunComparison], full: Sequence[RunComparison]
+) -> list[str]:
+    """The condensed Table 5 of docs/reproduction.md: per scenario, our medians over the ground
+    band and the full volume (the same queries) beside the paper's."""
+    ours = {run.scenario: run_summary(run) for run in ground}
+    whole = {run.scenario: run_summary(run) for run in full}
+    edges = {run.scenario: dataclasses.asdict(run.edge_check) for run in ground}
+    columns = [s for s in ours if s in PAPER_TABLE5]
+    papers = {s: paper_summary(PAPER_TABLE5[s]) for s in columns}
+    header = " | ".join(
+        f"S{SCENARIO_NUMBER[s]} ours | S{SCENARIO_NUMBER[s]} paper" for s in columns
+    )
+    lines = [
+        f"| Measure (median unless stated) | {header} |",
+        "|---" * (1 + 2 * len(columns)) + "|",
+    ]
+
+    def row(name: str, our_cell, paper_cell=None) -> None:
+        cells = []
+        for s in columns:
+            cells += [our_cell(s), paper_cell(s) if paper_cell else "-"]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+
+    def cell(summaries: dict[Any, Any], key: str, fmt, stat: str = "median"):
+        return lambda s: fmt(summaries[s][key][stat])
+
+    def median_min(summaries: dict[Any, Any], key: str):
+        return lambda s: (
+            f"{_ratio(summaries[s][key]['median'])} / {_ratio(summaries[s][key]['min'])}"
+        )
+
+    both, search = (ours, papers), "time_ratio_0.5_search"
+    row("HP Target-layer search (µs)", *(cell(x, "hp_target_layer_s", _us) for x in both))
+    row("HP Pose/Level-layer searches (µs)", *(cell(x, "hp_local_layers_s", _us) for x in both))
+    row("HP end to end: parse, localise, search, waypoints (µs)", cell(ours, "hp_query_s", _us))
+    row("VP at 0.5 m, ground band (ms)", *(cell(x, "vp_0.5_s", _ms) for x in both))
+    if whole:
+        row("VP at 0.5 m, full volume (ms)", *(cell(x, "vp_0.5_s", _ms) for x in (whole, papers)))
+    row("VP at 0.7 m, ground band (ms)", *(cell(x, "vp_0.7_s", _ms) for x in both))
+    row(
+        "VP/HP time at 0.5 m, searches, ground (median / min)",
+        *(median_min(x, search) for x in both),
+    )
+    if whole:
+        row("VP/HP time at 0.5 m, searches, full (median / min)", median_min(whole, search))
+    row(
+        "VP/HP time at 0.5 m, end to end, ground (median / min)",
+        median_min(ours, "time_ratio_0.5_query"),
+    )
+    row("HP/VP length at 0.5 m (mean)", *(cell(x, "length_ratio_0.5", _num, "mean") for x in both))
+    row(
+        "refined HP / VP length at 0.5 m (mean)",
+        cell(ours, "refined_length_ratio_0.5", _num, "mean"),
+    )
+    checks = ("hp_valid_segments", "refined_valid_segments", "vp_0.5_valid_segments")
+    row(
+        "valid segments: graph edges, HP, refined, VP 0.5 m",
+        lambda s: ", ".join(_pct(share) for share in (edges[s], *(ours[s][k] for k in checks))),
+    )
+    return lines
+
+
 def table5_markdown(runs: Sequence[RunComparison]) -> str:
     lines = ["## Hierarchical versus volumetric planning (000 Table 5 analogue)", ""]
     for run in runs:
@@ -237,20 +300,78 @@ def table5_markdown(runs: Sequence[RunComparison]) -> str:
     return "\n".join(lines)
 
 
+def common_target_rmse(outcomes: Sequence[MissionOutcome], planner: str) -> float | None:
+    """Horizontal RMSE of ``planner``'s missions over the targets that both planners inspected in
+    the same scenario and seed, pooled over the runs: the two planners scored on one target set
+    (each mission's own RMSE covers whatever it inspected within its budget)."""
+    runs = {(o.scenario, o.seed, o.planner): o for o in outcomes}
+    errors = []
+    for (scenario, seed, name), outcome in runs.items():
+        other = runs.get((scenario, seed, _other_planner(name)))
+        if name != planner or other is None:
+            continue
+        shared = outcome.inspected_errors.keys() & other.inspected_errors.keys()
+        errors += [outcome.inspected_errors[truth] for truth in shared]
+    return math.sqrt(statistics.fmean(e * e for e in errors)) if errors else None
+
+
+def _other_planner(planner: str) -> str:
+    return "volumetric" if planner == "hierarchical" else "hierarchical"
+
+
+def _spread(values: Iterable[float | None], digits: int) -> str:
+    """Mean, and the range over the runs in square brackets where they differ."""
+    summary = stats(values)
+    if summary["n"] == 0:
+        return "-"
+    low, high = _num(summary["min"], digits), _num(summary["max"], digits)
+    return _num(summary["mean"], digits) + (f" [{low}-{high}]" if low != high else "")
+
+
+def table6_summary(outcomes: Sequence[MissionOutcome]) -> str:
+    """One row per scenario and planner over the seeds: mean [min-max], the paper's figure in
+    brackets where 000 Table 6 gives one."""
+    lines = [
+        "| Scenario | Planner | seeds | planning load % | CPU load % (paper) "
+        "| coverage m³ (paper) | RMSE m, own targets (paper) | RMSE m, common targets "
+        "| inspected / true | sim s |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    groups: dict[tuple[str, str], list[MissionOutcome]] = {}
+    for o in outcomes:
+        groups.setdefault((o.scenario, o.planner), []).append(o)
+    for (scenario, planner), runs in groups.items():
+        cpu, cover, rmse = PAPER_TABLE6.get(scenario, {}).get(planner, (None, None, None))
+        common = common_target_rmse([o for o in outcomes if o.scenario == scenario], planner)
+        inspected = "; ".join(f"{o.inspected} / {o.true_targets}" for o in runs)
+        lines.append(
+            f"| {scenario} | {planner} | {', '.join(str(o.seed) for o in runs)} "
+            f"| {_spread((o.planning_load_pct for o in runs), 3)} "
+            f"| {_spread((o.cpu_load_pct for o in runs), 1)} ({_num(cpu, 1)}) "
+            f"| {_spread((o.bbox_volume_m3 for o in runs), 1)} ({_num(cover, 1)}) "
+            f"| {_spread((o.rmse_m for o in runs), 3)} ({_num(rmse, 3)}) "
+            f"| {_num(common, 3)} | {inspected} | {_spread((o.sim_time_s for o in runs), 0)} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
 def table6_markdown(outcomes: Sequence[MissionOutcome]) -> str:
     lines = [
         "## Mission-level effect (000 Table 6 analogue; planning time charged to the robot)",
         "",
-        "| Scenario | Planner | CPU load % (paper) | planning load % | coverage m³ (paper) "
-        "| surface coverage % | RMSE m (paper) | inspected / true | sim s | planning wall s "
-        "| route plans |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        table6_summary(outcomes),
+        "Each run:",
+        "",
+        "| Scenario | seed | Planner | CPU load % (paper) | planning load % "
+        "| coverage m³ (paper) | surface coverage % | RMSE m (paper) | inspected / true | sim s "
+        "| planning wall s | route plans |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for o in outcomes:
         paper = PAPER_TABLE6.get(o.scenario, {}).get(o.planner)
         cpu, cover, rmse = paper if paper else (None, None, None)
         lines.append(
-            f"| {o.scenario} | {o.planner} | {_num(o.cpu_load_pct, 1)} ({_num(cpu, 1)}) "
+            f"| {o.scenario} | {o.seed} | {o.planner} | {_num(o.cpu_load_pct, 1)} ({_num(cpu, 1)}) "
             f"| {_num(o.planning_load_pct, 3)} | {_num(o.bbox_volume_m3, 1)} ({_num(cover, 1)}) "
             f"| {_num(o.surface_coverage_pct, 1)} | {_num(o.rmse_m, 3)} ({_num(rmse, 3)}) "
             f"| {o.inspected} / {o.true_targets} | {o.sim_time_s:.0f} | {o.planning_wall_s:.2f} "

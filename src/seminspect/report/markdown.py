@@ -1,0 +1,74 @@
+"""Generated sections inside hand-written Markdown: tables that a command rewrites in place.
+
+A section is the text between ``<!-- BEGIN table:NAME -->`` and ``<!-- END table:NAME -->``
+lines; everything outside the markers is left as written, so prose and the paper's own rows
+stay hand-edited while measured tables are regenerated (``bench/reproduction.py``).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections.abc import Callable, Mapping
+from pathlib import Path
+
+from seminspect.core.errors import FileFormatError
+from seminspect.core.io import atomic_write_text
+
+_MARKER = re.compile(r"^<!-- (BEGIN|END) table:([\w.-]+) -->$", re.MULTILINE)
+
+
+def section_names(text: str) -> list[str]:
+    """The names of the generated sections of ``text``, in order; malformed markers (an END
+    without its BEGIN, a section opened twice or never closed) raise ``FileFormatError``."""
+    names: list[str] = []
+    open_name: str | None = None
+    for match in _MARKER.finditer(text):
+        kind, name = match.groups()
+        if kind == "BEGIN":
+            if open_name is not None:
+                raise FileFormatError(f"section {open_name!r} is not closed before {name!r}")
+            if name in names:
+                raise FileFormatError(f"section {name!r} appears twice")
+            open_name = name
+        elif name != open_name:
+            raise FileFormatError(f"END of section {name!r} without its BEGIN")
+        else:
+            names.append(name)
+            open_name = None
+    if open_name is not None:
+        raise FileFormatError(f"section {open_name!r} is never closed")
+    return names
+
+
+def replace_sections(text: str, sections: Mapping[str, str]) -> str:
+    """``text`` with the body of each named section replaced; sections not named are kept."""
+    unknown = sorted(set(sections) - set(section_names(text)))
+    if unknown:
+        raise FileFormatError(f"no section named {', '.join(unknown)} in the document")
+    for name, body in sections.items():
+        key = re.escape(name)
+        pattern = re.compile(
+            rf"(^<!-- BEGIN table:{key} -->\n).*?(^<!-- END table:{key} -->$)",
+            re.MULTILINE | re.DOTALL,
+        )
+        text = pattern.sub(_verbatim(body.strip("\n") + "\n"), text, count=1)
+    return text
+
+
+def _verbatim(lines: str) -> Callable[[re.Match[str]], str]:
+    """A replacement function: the body is written as given, backslashes and all."""
+    return lambda match: match.group(1) + lines + match.group(2)
+
+
+def rewrite_sections(path: str | os.PathLike[str], sections: Mapping[str, str]) -> Path:
+    """Replace the named sections of the Markdown file at ``path`` (atomically)."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise FileFormatError(f"{path}: cannot read ({exc.strerror})") from exc
+    try:
+        return atomic_write_text(path, replace_sections(text, sections))
+    except FileFormatError as exc:
+        raise FileFormatError(f"{path}: {exc}") from exc

@@ -1,0 +1,59 @@
+import pytest
+
+from seminspect.core.errors import FileFormatError
+from seminspect.report.markdown import replace_sections, rewrite_sections, section_names
+
+DOC = """# Results
+
+Prose that stays.
+
+<!-- BEGIN table:t3 -->
+| a | b |
+|---|---|
+| 1 | 2 |
+<!-- END table:t3 -->
+
+More prose.
+<!-- BEGIN table:t6 -->
+old
+<!-- END table:t6 -->
+"""
+
+
+def test_only_the_named_sections_are_rewritten() -> None:
+    new = replace_sections(DOC, {"t3": "| a | b |\n|---|---|\n| 3 | 4 |\n"})
+    assert "| 3 | 4 |" in new and "| 1 | 2 |" not in new
+    assert "Prose that stays." in new and "More prose." in new and "\nold\n" in new
+    assert section_names(new) == ["t3", "t6"]
+    assert replace_sections(new, {"t3": "| a | b |\n|---|---|\n| 1 | 2 |"}) == DOC
+
+
+def test_a_body_with_regex_escapes_is_written_verbatim() -> None:
+    body = r"path \1 and \g<0> stay as written"
+    assert body + "\n<!-- END table:t6 -->" in replace_sections(DOC, {"t6": body})
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("<!-- BEGIN table:x -->\n", "'x' is never closed"),
+        ("<!-- END table:x -->\n", "END of section 'x' without its BEGIN"),
+        ("<!-- BEGIN table:x -->\n<!-- BEGIN table:y -->\n", "'x' is not closed before 'y'"),
+        (DOC + DOC, "'t3' appears twice"),
+    ],
+)
+def test_malformed_markers_are_refused(text: str, message: str) -> None:
+    with pytest.raises(FileFormatError, match=message):
+        section_names(text)
+
+
+def test_an_unknown_section_is_refused_and_the_file_kept(tmp_path) -> None:
+    doc = tmp_path / "doc.md"
+    doc.write_text(DOC, encoding="utf-8")
+    with pytest.raises(FileFormatError, match="no section named t9"):
+        rewrite_sections(doc, {"t9": "x"})
+    assert doc.read_text(encoding="utf-8") == DOC
+    rewrite_sections(doc, {"t6": "new"})
+    assert "\nnew\n<!-- END table:t6 -->" in doc.read_text(encoding="utf-8")
+    with pytest.raises(FileFormatError, match="cannot read"):
+        rewrite_sections(tmp_path / "missing.md", {"t6": "x"})
