@@ -59,7 +59,9 @@ def reproducible_figures(metrics: dict[str, Any]) -> dict[str, Any]:
 @pytest.fixture(scope="module")
 def golden_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     out = tmp_path_factory.mktemp("golden") / "city-small-seed0"
-    return reproducible_figures(run_mission(make_config(CONFIG), out).metrics)
+    metrics = run_mission(make_config(CONFIG), out).metrics
+    assert metrics is not None
+    return reproducible_figures(metrics.to_json())
 
 
 @pytest.mark.slow
