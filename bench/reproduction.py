@@ -14,7 +14,7 @@ document; the prose and the paper's own rows around them are left as written. Se
 Mission runs go under ``--runs`` and are reused when a completed run of the same configuration
 is there (``--fresh`` deletes them first, so every figure comes from a new run).
 
-Run: ``.venv/bin/python bench/reproduction.py [--only table3-city ...] [--fresh]``
+Run: ``.venv/bin/python bench/reproduction.py [--only table3-city-small ...] [--fresh]``
 """
 
 from __future__ import annotations
