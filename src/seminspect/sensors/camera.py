@@ -22,6 +22,7 @@ from scipy.spatial.transform import Rotation
 
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.params import InspectionParams
+from seminspect.core.threads import rotate_rows
 from seminspect.geometry.transforms import Quat, Vec3, as_point, as_quaternion
 from seminspect.sensors.noise import NoiseModel, require_rng
 from seminspect.sensors.shading import OCTAVE_WEIGHTS, OCTAVES, shade_hits, surface_tables
@@ -159,7 +160,7 @@ class Frame:
             if use_odometry
             else (self.position, self.orientation)
         )
-        return body @ Rotation.from_quat(orientation).as_matrix().T + position
+        return rotate_rows(body, Rotation.from_quat(orientation).as_matrix()) + position
 
 
 def render(
@@ -188,7 +189,7 @@ def render(
     model = camera.scaled(stride)
     directions_body, cosine = model.rays
     rotation = Rotation.from_quat(quat).as_matrix().astype(np.float32)
-    directions = directions_body @ rotation.T
+    directions = rotate_rows(directions_body, rotation)
     distance, face = world.raycaster.cast(origin, directions, model.max_range / cosine)
     count = len(face)
     depth = np.empty(count, dtype=np.float32)
