@@ -22,6 +22,7 @@ from __future__ import annotations
 import argparse
 import tempfile
 import time
+from collections import defaultdict
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager, suppress
 from functools import wraps
@@ -45,10 +46,19 @@ STAGES = (
 
 
 class _Registry:
-    """The mission's ``Timers`` (captured at construction), or a private one outside it."""
+    """The mission's ``Timers`` (captured at construction), or a private one before it."""
 
     def __init__(self) -> None:
         self.timers: metrics.Timers = metrics.Timers()
+        self.every = [self.timers]
+
+    def seconds(self) -> dict[str, float]:
+        """Seconds per stage and category, over the private timers and the mission's."""
+        total: dict[str, float] = defaultdict(float)
+        for timers in self.every:
+            for name, value in timers.seconds.items():
+                total[name] += value
+        return dict(total)
 
     def timed(self, stage: str, function: Callable[..., Any]) -> Callable[..., Any]:
         @wraps(function)
@@ -68,6 +78,7 @@ def staged(registry: _Registry) -> Iterator[None]:
     def capturing_init(timers: metrics.Timers) -> None:
         original_init(timers)
         registry.timers = timers
+        registry.every.append(timers)
 
     metrics.Timers.__init__ = capturing_init  # type: ignore[method-assign]
     for owner, name, stage in STAGES:
@@ -94,7 +105,7 @@ def main() -> None:
         result = run_mission(config, f"{out}/run")
         wall = time.perf_counter() - start
     mission = result.metrics["mission"]
-    seconds = dict(registry.timers.seconds)
+    seconds = registry.seconds()
     with suppress(KeyError):
         seconds["sensing (other)"] = seconds.pop("sensing")
     seconds["I/O, setup (untimed)"] = wall - sum(seconds.values())

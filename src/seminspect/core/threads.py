@@ -3,8 +3,8 @@
 Rotating a frame's rays is a ``(N, 3) @ (3, 3)`` product: far too little work per row for
 OpenBLAS to gain from its threads, yet it wakes them for every call, and on a busy machine the
 hand-over alone can cost many times the product (docs/benchmarks.md, "Missions at 50x real
-time"). One thread computes every row with the same
-kernel, so the result is bit-for-bit the multi-threaded one (``tests/core/test_threads.py``).
+time"). One thread computes every row with the same kernel, so the result is bit-for-bit the
+multi-threaded one (``tests/core/test_threads.py``).
 """
 
 from __future__ import annotations

@@ -249,7 +249,7 @@ def _add_image_noise(frame: Frame, noise: NoiseModel, rng: np.random.Generator) 
     All the normal deviates come from one draw: the hit pixels' depth noise first (row-major),
     then one per intensity pixel, the same numbers in the same order as two separate draws.
     """
-    depth = frame.depth.reshape(-1)
+    depth = frame.depth.reshape(-1)  # views: render's images are contiguous
     noisy_depth = bool(noise.depth_noise_m or noise.depth_noise_per_m)
     hits = int(np.count_nonzero(np.isfinite(depth))) if noisy_depth else 0
     pixels = frame.intensity.size if noise.intensity_noise else 0
