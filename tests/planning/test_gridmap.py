@@ -113,6 +113,18 @@ def test_planar_band_blocks_a_column_when_any_cell_in_the_band_is_occupied(free_
     assert planar_states(grid_map, (0.2, 1.5))[2, 0, 0] == OCCUPIED
 
 
+def test_planar_band_equals_the_whole_band_comparison(free_map) -> None:
+    grid_map = free_map((30, 20, 12), 0.2)
+    rng = np.random.default_rng(4)
+    grid_map.states[:] = rng.choice([FREE, OCCUPIED, UNKNOWN], grid_map.shape, p=[0.8, 0.05, 0.15])
+    column = grid_map.states[:, :, 2:8]  # the cells a band of 0.45-1.55 m overlaps
+    occupied, unknown = (column == OCCUPIED).any(axis=2), (column == UNKNOWN).any(axis=2)
+    expected = np.where(occupied, OCCUPIED, np.where(unknown, UNKNOWN, FREE))
+    layer = planar_states(grid_map, (0.45, 1.55))[:, :, 0]
+    assert len(np.unique(layer)) == 3
+    np.testing.assert_array_equal(layer, expected)
+
+
 @pytest.mark.parametrize("band", [(1.0, 0.5), (3.0, 4.0), (float("nan"), 1.0)])
 def test_impossible_bands_are_refused(free_map, band) -> None:
     with pytest.raises(InvalidInputError, match="band"):

@@ -136,3 +136,33 @@ def test_strided_render_and_odometry_tagging(wall) -> None:
         render(wall, SMALL, (0.0, 0.0, math.nan), quat_from_yaw(0.0))
     with pytest.raises(InvalidInputError):
         render(wall, SMALL, (0.0, 0.0, 2.0), quat_from_yaw(0.0), stride=0)
+
+
+def _reference_image_noise(frame, noise, rng) -> None:
+    """The image noise as two numpy draws: the oracle the compiled single pass must equal."""
+    hit = np.isfinite(frame.depth)
+    if noise.depth_noise_m or noise.depth_noise_per_m:
+        sigma = noise.depth_noise_m + noise.depth_noise_per_m * frame.depth[hit]
+        noisy = frame.depth[hit] + rng.standard_normal(sigma.shape).astype(np.float32) * sigma
+        frame.depth[hit] = np.maximum(noisy, np.float32(1e-3))
+    if noise.intensity_noise:
+        jitter = rng.normal(0.0, noise.intensity_noise, frame.intensity.shape)
+        frame.intensity[:] = np.clip(frame.intensity + jitter, 0, 255).astype(np.uint8)
+
+
+@pytest.mark.parametrize(
+    "noise",
+    [
+        noise_preset("realistic"),
+        make_noise({"depth_noise_per_m": 0.05}),
+        make_noise({"intensity_noise": 40.0}),
+    ],
+)
+def test_image_noise_in_one_pass_equals_the_two_draws(noise) -> None:
+    pose = ((-8.0, 1.0, 1.5), quat_from_yaw(-0.1))
+    expected = render(car_world(), SMALL, *pose)
+    assert 0 < np.isfinite(expected.depth).mean() < 1  # both hits and sky in view
+    _reference_image_noise(expected, noise, make_rng(7, "camera"))
+    noisy = render(car_world(), SMALL, *pose, noise=noise, rng=make_rng(7, "camera"))
+    np.testing.assert_array_equal(noisy.depth, expected.depth)
+    np.testing.assert_array_equal(noisy.intensity, expected.intensity)

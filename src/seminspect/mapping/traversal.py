@@ -18,30 +18,26 @@ FREE = np.uint8(1)
 OCCUPIED = np.uint8(2)
 
 
-@numba.njit(cache=True)
-def _clip(o: np.ndarray, d: np.ndarray, shape: tuple) -> tuple[float, float]:
-    """Parameter interval [t0, t1] within [0, 1] of ``o + t d`` inside the grid box."""
-    t0, t1 = 0.0, 1.0
-    for k in range(3):
-        if d[k] == 0.0:
-            if o[k] < 0.0 or o[k] >= shape[k]:
-                return 1.0, 0.0
-            continue
-        ta = (0.0 - o[k]) / d[k]
-        tb = (shape[k] - o[k]) / d[k]
-        t0 = max(t0, min(ta, tb))
-        t1 = min(t1, max(ta, tb))
-    return t0, t1
+@numba.njit(cache=True, inline="always")
+def _clip_axis(t0: float, t1: float, o: float, d: float, size: int) -> tuple[float, float]:
+    """Narrow ``[t0, t1]`` to where ``o + t d`` lies within ``[0, size)`` on one axis."""
+    if d == 0.0:
+        if o < 0.0 or o >= size:
+            return 1.0, 0.0
+        return t0, t1
+    ta = (0.0 - o) / d
+    tb = (size - o) / d
+    return max(t0, min(ta, tb)), min(t1, max(ta, tb))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _mark(states: np.ndarray, i: int, j: int, k: int, value: np.uint8) -> None:
     """Set a cell, except that nothing overwrites OCCUPIED."""
     if states[i, j, k] != OCCUPIED:
         states[i, j, k] = value
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _start_axis(o: float, d: float, cell: int) -> tuple[int, float, float]:
     """Step direction, parameter of the first cell boundary and parameter per cell on one axis."""
     if d > 0:
@@ -51,42 +47,69 @@ def _start_axis(o: float, d: float, cell: int) -> tuple[int, float, float]:
     return 0, np.inf, np.inf
 
 
+@numba.njit(cache=True, inline="always")
+def _cell(x: float, size: int) -> int:
+    """The cell index of grid coordinate ``x``, clamped into ``[0, size)``."""
+    return min(max(math.floor(x), 0), size - 1)
+
+
+@numba.njit(cache=True, inline="always")
+def _advance(  # noqa: PLR0917 - inlined into the walk
+    cell: int, boundary: float, per_cell: float, step: int, size: int, t1: float
+) -> tuple[int, float, bool]:
+    """Step one cell along an axis; False once the ray ends or leaves the grid first."""
+    if boundary > t1:
+        return cell, boundary, False
+    cell += step
+    if cell < 0 or cell >= size:
+        return cell, boundary, False
+    return cell, boundary + per_cell, True
+
+
 @numba.njit(cache=True)
-def _walk(states: np.ndarray, o: np.ndarray, d: np.ndarray, hit: bool) -> None:
-    """Free every cell from the grid entry of ``o + t d`` to its end; occupy the end on a hit."""
-    shape = states.shape
-    t0, t1 = _clip(o, d, shape)
+def _walk(  # noqa: PLR0917 - scalars keep the per-ray walk free of allocations
+    states: np.ndarray,
+    ox: float,
+    oy: float,
+    oz: float,
+    dx: float,
+    dy: float,
+    dz: float,
+    hit: bool,
+) -> None:
+    """Free every cell from the grid entry of ``o + t d`` to its end; occupy the end on a hit.
+
+    Three scalars per axis rather than small arrays: the walk runs once per ray, and
+    allocating its state dominated short rays.
+    """
+    nx, ny, nz = states.shape
+    t0, t1 = _clip_axis(0.0, 1.0, ox, dx, nx)
+    t0, t1 = _clip_axis(t0, t1, oy, dy, ny)
+    t0, t1 = _clip_axis(t0, t1, oz, dz, nz)
     if t0 > t1:
         return
-    cell = np.empty(3, dtype=np.int64)
-    last = np.empty(3, dtype=np.int64)
-    step = np.empty(3, dtype=np.int64)
-    t_max = np.empty(3)
-    t_delta = np.empty(3)
-    for k in range(3):
-        cell[k] = min(max(math.floor(o[k] + t0 * d[k]), 0), shape[k] - 1)
-        last[k] = min(max(math.floor(o[k] + t1 * d[k]), 0), shape[k] - 1)
-        step[k], t_max[k], t_delta[k] = _start_axis(o[k], d[k], cell[k])
-    occupy_end = hit
-    for k in range(3):
-        occupy_end = occupy_end and 0.0 <= o[k] + d[k] < shape[k]
-    for _ in range(shape[0] + shape[1] + shape[2] + 3):
-        if cell[0] == last[0] and cell[1] == last[1] and cell[2] == last[2]:
+    i, j, k = _cell(ox + t0 * dx, nx), _cell(oy + t0 * dy, ny), _cell(oz + t0 * dz, nz)
+    li, lj, lk = _cell(ox + t1 * dx, nx), _cell(oy + t1 * dy, ny), _cell(oz + t1 * dz, nz)
+    si, mi, di = _start_axis(ox, dx, i)
+    sj, mj, dj = _start_axis(oy, dy, j)
+    sk, mk, dk = _start_axis(oz, dz, k)
+    occupy_end = hit and 0.0 <= ox + dx < nx and 0.0 <= oy + dy < ny and 0.0 <= oz + dz < nz
+    for _ in range(nx + ny + nz + 3):
+        if i == li and j == lj and k == lk:
             break
-        _mark(states, cell[0], cell[1], cell[2], FREE)
-        axis = 0
-        if t_max[1] < t_max[axis]:
-            axis = 1
-        if t_max[2] < t_max[axis]:
-            axis = 2
-        if t_max[axis] > t1:
+        _mark(states, i, j, k, FREE)
+        # The axis whose next boundary comes first; ties go to the lower axis.
+        axis = (2 if mk < mj else 1) if mj < mi else (2 if mk < mi else 0)
+        if axis == 0:
+            i, mi, inside = _advance(i, mi, di, si, nx, t1)
+        elif axis == 1:
+            j, mj, inside = _advance(j, mj, dj, sj, ny, t1)
+        else:
+            k, mk, inside = _advance(k, mk, dk, sk, nz, t1)
+        if not inside:
             break
-        cell[axis] += step[axis]
-        if cell[axis] < 0 or cell[axis] >= shape[axis]:
-            break
-        t_max[axis] += t_delta[axis]
     # The end cell is set even when rounding let the walk slip past it along an edge or corner.
-    _mark(states, last[0], last[1], last[2], OCCUPIED if occupy_end else FREE)
+    _mark(states, li, lj, lk, OCCUPIED if occupy_end else FREE)
 
 
 @numba.njit(cache=True)
@@ -99,12 +122,19 @@ def integrate_rays_kernel(  # noqa: PLR0917 - a compiled kernel takes its arrays
     hit: np.ndarray,
 ) -> None:
     """Walk every ray ``origins[r or 0] -> ends[r]`` (world metres) through ``states``."""
-    o = np.empty(3)
-    d = np.empty(3)
     shared = origins.shape[0] == 1
     for r in range(ends.shape[0]):
         src = origins[0] if shared else origins[r]
-        for k in range(3):
-            o[k] = (src[k] - grid_origin[k]) / resolution
-            d[k] = (ends[r, k] - grid_origin[k]) / resolution - o[k]
-        _walk(states, o, d, hit[r])
+        ox = (src[0] - grid_origin[0]) / resolution
+        oy = (src[1] - grid_origin[1]) / resolution
+        oz = (src[2] - grid_origin[2]) / resolution
+        _walk(
+            states,
+            ox,
+            oy,
+            oz,
+            (ends[r, 0] - grid_origin[0]) / resolution - ox,
+            (ends[r, 1] - grid_origin[1]) / resolution - oy,
+            (ends[r, 2] - grid_origin[2]) / resolution - oz,
+            hit[r],
+        )

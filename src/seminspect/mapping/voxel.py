@@ -24,6 +24,7 @@ from scipy.spatial.transform import Rotation
 
 from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.core.io import save_npz_atomic
+from seminspect.core.threads import rotate_rows
 from seminspect.geometry.raster import cells_touching_triangles
 from seminspect.geometry.transforms import as_point, as_points
 from seminspect.mapping.semantic_cloud import read_npz
@@ -210,7 +211,7 @@ class VoxelMap:
             else (frame.position, frame.orientation)
         )
         rotation = Rotation.from_quat(orientation).as_matrix()
-        ends = position + (directions[flat] * length[:, None]) @ rotation.T
+        ends = position + rotate_rows(directions[flat] * length[:, None], rotation)
         self.integrate_rays(position, ends, hit)
 
     def integrate_scan(self, scan: LidarScan, clear_misses_to: float | None = None) -> None:

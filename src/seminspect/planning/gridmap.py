@@ -104,11 +104,28 @@ def planar_states(voxel_map: VoxelMap, band: tuple[float, float]) -> NDArray[np.
         raise InvalidInputError(
             f"height band [{z_low}, {z_high}] m misses the map, which spans z {z0:g}..{top:g} m"
         )
-    column = voxel_map.states[:, :, k_low:k_high]
-    occupied = (column == OCCUPIED).any(axis=2)
-    unknown = (column == UNKNOWN).any(axis=2)
-    layer = np.where(occupied, OCCUPIED, np.where(unknown, UNKNOWN, FREE)).astype(np.uint8)
-    return layer[:, :, None]
+    layer = np.empty((*voxel_map.shape[:2], 1), dtype=np.uint8)
+    _project_band(voxel_map.states, k_low, k_high, layer)
+    return layer
+
+
+@numba.njit(cache=True)
+def _project_band(states: np.ndarray, k_low: int, k_high: int, layer: np.ndarray) -> None:
+    """Per column: OCCUPIED if any band cell is, else UNKNOWN if any is, else FREE.
+
+    One pass that stops at a column's first occupied cell, instead of two whole-band
+    comparisons and their temporaries (the map is projected at every local plan).
+    """
+    for i in range(states.shape[0]):
+        for j in range(states.shape[1]):
+            value = FREE
+            for k in range(k_low, k_high):
+                if states[i, j, k] == OCCUPIED:
+                    value = OCCUPIED
+                    break
+                if states[i, j, k] == UNKNOWN:
+                    value = UNKNOWN
+            layer[i, j, 0] = value
 
 
 def obstacle_offsets(

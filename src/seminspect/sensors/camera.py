@@ -16,12 +16,14 @@ import math
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 
+import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.params import InspectionParams
+from seminspect.core.threads import rotate_rows
 from seminspect.geometry.transforms import Quat, Vec3, as_point, as_quaternion
 from seminspect.sensors.noise import NoiseModel, require_rng
 from seminspect.sensors.shading import OCTAVE_WEIGHTS, OCTAVES, shade_hits, surface_tables
@@ -159,7 +161,7 @@ class Frame:
             if use_odometry
             else (self.position, self.orientation)
         )
-        return body @ Rotation.from_quat(orientation).as_matrix().T + position
+        return rotate_rows(body, Rotation.from_quat(orientation).as_matrix()) + position
 
 
 def render(
@@ -188,7 +190,7 @@ def render(
     model = camera.scaled(stride)
     directions_body, cosine = model.rays
     rotation = Rotation.from_quat(quat).as_matrix().astype(np.float32)
-    directions = directions_body @ rotation.T
+    directions = rotate_rows(directions_body, rotation)
     distance, face = world.raycaster.cast(origin, directions, model.max_range / cosine)
     count = len(face)
     depth = np.empty(count, dtype=np.float32)
@@ -244,12 +246,51 @@ def render(
 
 
 def _add_image_noise(frame: Frame, noise: NoiseModel, rng: np.random.Generator) -> None:
-    """Depth noise with a range-dependent sigma, and pixel noise on the intensity image."""
-    hit = np.isfinite(frame.depth)
-    if noise.depth_noise_m or noise.depth_noise_per_m:
-        sigma = noise.depth_noise_m + noise.depth_noise_per_m * frame.depth[hit]
-        noisy = frame.depth[hit] + rng.standard_normal(sigma.shape).astype(np.float32) * sigma
-        frame.depth[hit] = np.maximum(noisy, np.float32(1e-3))
-    if noise.intensity_noise:
-        jitter = rng.normal(0.0, noise.intensity_noise, frame.intensity.shape)
-        frame.intensity[:] = np.clip(frame.intensity + jitter, 0, 255).astype(np.uint8)
+    """Depth noise with a range-dependent sigma, and pixel noise on the intensity image.
+
+    All the normal deviates come from one draw: the hit pixels' depth noise first (row-major),
+    then one per intensity pixel, the same numbers in the same order as two separate draws.
+    """
+    depth = frame.depth.reshape(-1)  # views: render's images are contiguous
+    noisy_depth = bool(noise.depth_noise_m or noise.depth_noise_per_m)
+    hits = int(np.count_nonzero(np.isfinite(depth))) if noisy_depth else 0
+    pixels = frame.intensity.size if noise.intensity_noise else 0
+    _apply_image_noise(
+        depth,
+        frame.intensity.reshape(-1),
+        rng.standard_normal(hits + pixels),
+        hits > 0,
+        np.float32(noise.depth_noise_m),
+        np.float32(noise.depth_noise_per_m),
+        float(noise.intensity_noise),
+    )
+
+
+@numba.njit(cache=True)
+def _apply_image_noise(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
+    depth: np.ndarray,
+    intensity: np.ndarray,
+    normals: np.ndarray,
+    noisy_depth: bool,
+    sigma_0: np.float32,
+    sigma_per_m: np.float32,
+    intensity_sigma: float,
+) -> None:
+    """Add ``normals`` to the flat depth (hits only) and intensity images, in place.
+
+    The arithmetic is float32 for depth and float64 for intensity, as the numpy expressions it
+    replaces were (``tests/sensors/test_camera.py`` holds them as the reference).
+    """
+    k = 0
+    if noisy_depth:
+        floor = np.float32(1e-3)
+        for i in range(depth.shape[0]):
+            if np.isfinite(depth[i]):
+                sigma = sigma_0 + sigma_per_m * depth[i]
+                depth[i] = max(depth[i] + np.float32(normals[k]) * sigma, floor)
+                k += 1
+    if intensity_sigma:
+        for i in range(intensity.shape[0]):
+            value = intensity[i] + intensity_sigma * normals[k]
+            intensity[i] = np.uint8(min(max(value, 0.0), 255.0))
+            k += 1

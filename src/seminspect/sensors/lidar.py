@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from seminspect.core.errors import InvalidInputError
+from seminspect.core.threads import rotate_rows
 from seminspect.geometry.transforms import Vec3, as_point, as_quaternion
 from seminspect.sensors.noise import NoiseModel, require_rng
 from seminspect.worlds import World
@@ -103,7 +104,7 @@ class Lidar:
         origin = as_point(position, "LiDAR position")
         rotation = Rotation.from_quat(as_quaternion(orientation, "LiDAR orientation"))
         body, ring = self.rays
-        directions = body @ rotation.as_matrix().astype(np.float32).T
+        directions = rotate_rows(body, rotation.as_matrix().astype(np.float32))
         distance, face = world.raycaster.cast(origin, directions, self.max_range)
         hit = face >= 0
         ranges = distance[hit].astype(np.float64)

@@ -1,0 +1,126 @@
+"""Where a mission's wall time goes, stage by stage, against its ray-casting floor.
+
+Runs one fixed xFLIE mission (default: city small, seed 0, as configured by ``make_config``)
+and splits its wall time into stages:
+
+* ray casting: ``RayCaster.cast`` (Embree), for camera frames, LiDAR scans and any other query;
+* rendering: what ``render`` does around the rays (shading, labels, intensity texture);
+* noise: the image noise of a frame;
+* map integration: ``integrate_rays_kernel`` (free-space carving and occupied end cells);
+* the mission's own categories for the rest (perception, planning, graph, driving, and
+  sensing left after the stages above), and I/O and setup as what no timer covers.
+
+The stages are timed by wrapping those functions for the run only, and charged to the mission's
+own ``Timers`` so that nested time counts once. The figure to drive down is the ratio of the
+total wall time to the ray-casting time (issue 16: <= 2.0).
+
+Run: ``PYTHONPATH=src .venv/bin/python bench/mission_profile.py [--scenario small] [--seed 0]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+import time
+from collections import defaultdict
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager, suppress
+from functools import wraps
+from typing import Any
+
+from seminspect.mapping import voxel
+from seminspect.missions import metrics, platform
+from seminspect.missions.config import make_config
+from seminspect.missions.run import run_mission
+from seminspect.sensors import camera
+from seminspect.worlds import raycast
+
+#: (module, attribute, stage): the functions timed as their own stage.
+STAGES = (
+    (raycast.RayCaster, "cast", "ray casting"),
+    (camera, "shade_hits", "rendering"),
+    (platform, "render", "rendering"),
+    (camera, "_add_image_noise", "noise"),
+    (voxel, "integrate_rays_kernel", "map integration"),
+)
+
+
+class _Registry:
+    """The mission's ``Timers`` (captured at construction), or a private one before it."""
+
+    def __init__(self) -> None:
+        self.timers: metrics.Timers = metrics.Timers()
+        self.every = [self.timers]
+
+    def seconds(self) -> dict[str, float]:
+        """Seconds per stage and category, over the private timers and the mission's."""
+        total: dict[str, float] = defaultdict(float)
+        for timers in self.every:
+            for name, value in timers.seconds.items():
+                total[name] += value
+        return dict(total)
+
+    def timed(self, stage: str, function: Callable[..., Any]) -> Callable[..., Any]:
+        @wraps(function)
+        def wrapper(*args: Any, **kwargs: Any) -> Any:
+            with self.timers(stage):
+                return function(*args, **kwargs)
+
+        return wrapper
+
+
+@contextmanager
+def staged(registry: _Registry) -> Iterator[None]:
+    """Wrap the stage functions and capture the mission's timers, for the block only."""
+    original_init = metrics.Timers.__init__
+    saved = [(owner, name, getattr(owner, name)) for owner, name, _ in STAGES]
+
+    def capturing_init(timers: metrics.Timers) -> None:
+        original_init(timers)
+        registry.timers = timers
+        registry.every.append(timers)
+
+    metrics.Timers.__init__ = capturing_init  # type: ignore[method-assign]
+    for owner, name, stage in STAGES:
+        setattr(owner, name, registry.timed(stage, getattr(owner, name)))
+    try:
+        yield
+    finally:
+        metrics.Timers.__init__ = original_init  # type: ignore[method-assign]
+        for owner, name, function in saved:
+            setattr(owner, name, function)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--world", default="city")
+    parser.add_argument("--scenario", default="small")
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args()
+
+    config = make_config({"world": args.world, "scenario": args.scenario, "seed": args.seed})
+    registry = _Registry()
+    with tempfile.TemporaryDirectory() as out, staged(registry):
+        start = time.perf_counter()
+        result = run_mission(config, f"{out}/run")
+        wall = time.perf_counter() - start
+    mission = result.metrics["mission"]
+    seconds = registry.seconds()
+    with suppress(KeyError):
+        seconds["sensing (other)"] = seconds.pop("sensing")
+    seconds["I/O, setup (untimed)"] = wall - sum(seconds.values())
+    casting = seconds.get("ray casting", 0.0)
+    print(f"mission {args.world} {args.scenario} seed {args.seed}: {result.state}")
+    print(
+        f"simulated {mission['sim_time_s']:.0f} s in {wall:.1f} s wall: "
+        f"{mission['sim_time_s'] / wall:.1f}x real time; {mission['frames']} frames, "
+        f"{mission['lidar_scans']} scans"
+    )
+    print(f"{'stage':<22} {'seconds':>8} {'share':>7}")
+    for stage, value in sorted(seconds.items(), key=lambda item: -item[1]):
+        print(f"{stage:<22} {value:8.2f} {100 * value / wall:6.1f}%")
+    print(f"total / ray casting: {wall / casting:.2f}  (target <= 2.0)")
+
+
+if __name__ == "__main__":
+    main()

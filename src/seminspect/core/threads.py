@@ -1,0 +1,28 @@
+"""Small matrix products on one BLAS thread.
+
+Rotating a frame's rays is a ``(N, 3) @ (3, 3)`` product: far too little work per row for
+OpenBLAS to gain from its threads, yet it wakes them for every call, and on a busy machine the
+hand-over alone can cost many times the product (docs/benchmarks.md, "Missions at 50x real
+time"). One thread computes every row with the same kernel, so the result is bit-for-bit the
+multi-threaded one (``tests/core/test_threads.py``).
+"""
+
+from __future__ import annotations
+
+from functools import cache
+
+import numpy as np
+from numpy.typing import NDArray
+from threadpoolctl import ThreadpoolController
+
+
+@cache
+def _controller() -> ThreadpoolController:
+    # Inspecting the loaded libraries takes milliseconds: do it once per process.
+    return ThreadpoolController()
+
+
+def rotate_rows(vectors: NDArray, rotation: NDArray) -> NDArray:
+    """``vectors @ rotation.T`` (``(N, 3)`` rows by a ``(3, 3)`` matrix) on one BLAS thread."""
+    with _controller().limit(limits=1, user_api="blas"):
+        return np.asarray(vectors) @ np.asarray(rotation).T

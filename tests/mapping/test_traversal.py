@@ -1,0 +1,91 @@
+"""The allocation-free ray walk against the array-based walk it replaced, cell for cell."""
+
+import math
+
+import numpy as np
+import pytest
+
+from seminspect.mapping.traversal import FREE, OCCUPIED, integrate_rays_kernel
+
+
+def _reference_clip(o, d, shape) -> tuple[float, float]:
+    t0, t1 = 0.0, 1.0
+    for k in range(3):
+        if d[k] == 0.0:
+            if o[k] < 0.0 or o[k] >= shape[k]:
+                return 1.0, 0.0
+            continue
+        ta, tb = (0.0 - o[k]) / d[k], (shape[k] - o[k]) / d[k]
+        t0, t1 = max(t0, min(ta, tb)), min(t1, max(ta, tb))
+    return t0, t1
+
+
+def _reference_walk(states, o, d, hit) -> None:
+    """The previous walk (per-ray state in small arrays), in plain Python: the oracle."""
+    shape = states.shape
+    t0, t1 = _reference_clip(o, d, shape)
+    if t0 > t1:
+        return
+    cell = [min(max(math.floor(o[k] + t0 * d[k]), 0), shape[k] - 1) for k in range(3)]
+    last = [min(max(math.floor(o[k] + t1 * d[k]), 0), shape[k] - 1) for k in range(3)]
+    step, t_max, t_delta = [0] * 3, [math.inf] * 3, [math.inf] * 3
+    for k in range(3):
+        if d[k] > 0:
+            step[k], t_max[k], t_delta[k] = 1, (cell[k] + 1 - o[k]) / d[k], 1.0 / d[k]
+        elif d[k] < 0:
+            step[k], t_max[k], t_delta[k] = -1, (cell[k] - o[k]) / d[k], -1.0 / d[k]
+    occupy_end = hit and all(0.0 <= o[k] + d[k] < shape[k] for k in range(3))
+
+    def mark(index, value) -> None:
+        if states[tuple(index)] != OCCUPIED:
+            states[tuple(index)] = value
+
+    for _ in range(sum(shape) + 3):
+        if cell == last:
+            break
+        mark(cell, FREE)
+        axis = 0
+        if t_max[1] < t_max[axis]:
+            axis = 1
+        if t_max[2] < t_max[axis]:
+            axis = 2
+        if t_max[axis] > t1:
+            break
+        cell[axis] += step[axis]
+        if cell[axis] < 0 or cell[axis] >= shape[axis]:
+            break
+        t_max[axis] += t_delta[axis]
+    mark(last, OCCUPIED if occupy_end else FREE)
+
+
+def _reference(states, grid, origins, ends, hit) -> None:
+    grid_origin, resolution = grid
+    for r in range(len(ends)):
+        src = origins[0] if len(origins) == 1 else origins[r]
+        o = (src - grid_origin) / resolution
+        _reference_walk(states, o, (ends[r] - grid_origin) / resolution - o, bool(hit[r]))
+
+
+def _random_rays(rng, count, shared_origin):
+    """Rays inside, across and outside a 6 x 5 x 4 m box, some along grid lines and axes."""
+    ends = rng.uniform([-2, -2, -2], [8, 7, 6], (count, 3))
+    ends[: count // 4] = np.round(ends[: count // 4] * 2) / 2  # on cell borders
+    origins = rng.uniform([-1, -1, -1], [7, 6, 5], (1 if shared_origin else count, 3))
+    if not shared_origin:
+        ends[count // 4 : count // 2, 1:] = origins[count // 4 : count // 2, 1:]  # along x
+    return origins, ends, rng.random(count) < 0.7
+
+
+@pytest.mark.parametrize("shared_origin", [True, False])
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_walk_marks_the_same_cells_as_the_reference(shared_origin, seed) -> None:
+    rng = np.random.default_rng(seed)
+    grid_origin, resolution = np.array([0.0, 0.0, 0.0]), 0.25
+    expected = np.zeros((24, 20, 16), dtype=np.uint8)
+    expected[rng.random(expected.shape) < 0.02] = OCCUPIED  # surfaces seen before
+    states = expected.copy()
+    origins, ends, hit = _random_rays(rng, 600, shared_origin)
+    _reference(expected, (grid_origin, resolution), origins, ends, hit)
+    integrate_rays_kernel(states, grid_origin, resolution, origins, ends, hit)
+    assert (expected == FREE).sum() > 1000 and (expected == OCCUPIED).sum() > 200
+    np.testing.assert_array_equal(states, expected)
