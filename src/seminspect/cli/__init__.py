@@ -118,9 +118,8 @@ def _report(exc: BaseException) -> int:
     elif isinstance(exc, _USAGE_ERROR):
         code = 0 if type(exc).__name__ == "NoArgsIsHelpError" else 2  # 0: the help was printed
         if code:
-            usage: Any = exc  # click's UsageError, found at import time (see _USAGE_ERROR)
-            command = usage.ctx.command_path if usage.ctx else "seminspect"
-            _error("error:", f"{usage.format_message()} (see '{command} --help')")
+            command = exc.ctx.command_path if exc.ctx else "seminspect"
+            _error("error:", f"{exc.format_message()} (see '{command} --help')")
     elif isinstance(exc, KeyboardInterrupt | typer.Abort):
         stop = as_interrupted(exc) if isinstance(exc, KeyboardInterrupt) else Interrupted()
         err_console.print(stop.describe(), highlight=False)

@@ -134,20 +134,21 @@ def _run_routine(
     progress: Callable[[str, float], None] | None,
 ) -> RoutineResult:
     started = time.perf_counter()
-    missions: list[RoutineMission] = []
+    mission: RoutineMission | None = None
     metrics: dict[str, Any] = {}
 
     def work() -> str:
+        nonlocal mission
         prior = _prior(config, site, run, prior_path, progress)
-        missions.append(RoutineMission(config, site, prior, regions, progress))
-        return missions[0].execute()
+        mission = RoutineMission(config, site, prior, regions, progress)
+        return mission.execute()
 
     def write_outputs(end: RunEnd) -> None:
         nonlocal metrics
-        if missions:
+        if mission is not None:
             wall_s = time.perf_counter() - started
-            metrics = routine_metrics(missions[0], site, end.state, end.reason, wall_s)
-            _write_outputs(run, missions[0], metrics)
+            metrics = routine_metrics(mission, site, end.state, end.reason, wall_s)
+            _write_outputs(run, mission, metrics)
 
     end = conduct_run(run, work, write_outputs, expected=ROUTINE_OUTPUTS, what="routine run")
     return RoutineResult(run.root, end.state, end.reason, metrics)
