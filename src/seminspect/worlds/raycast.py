@@ -8,6 +8,10 @@ directly instead of intersecting rays with triangle planes afterwards.
 
 from __future__ import annotations
 
+import itertools
+from concurrent.futures import ThreadPoolExecutor
+from functools import cache
+
 import numpy as np
 from embreex import rtcore_scene
 from embreex.mesh_construction import TriangleMesh
@@ -17,6 +21,8 @@ from seminspect.core.errors import InvalidInputError
 
 #: Embree's "no hit" primitive id.
 NO_HIT = -1
+#: Below this many rays per thread, splitting a batch costs more than it saves.
+MIN_RAYS_PER_THREAD = 4096
 
 
 class RayCaster:
@@ -48,6 +54,7 @@ class RayCaster:
         origins: ArrayLike,
         directions: ArrayLike,
         max_range: float | ArrayLike = np.inf,
+        threads: int = 1,
     ) -> tuple[NDArray[np.float32], NDArray[np.int32]]:
         """Distance to and index of the first triangle hit by each ray.
 
@@ -56,6 +63,8 @@ class RayCaster:
             directions: ``(N, 3)`` unit directions (not normalised here: distances are in
                 units of the direction's length).
             max_range: ignore hits farther than this, one value or one per ray.
+            threads: split the rays over this many threads (Embree releases the GIL, so
+                large batches scale with cores; results do not depend on the split).
 
         Returns:
             ``(distance, face)``: ``float32`` distances (``inf`` for no hit within range) and
@@ -75,8 +84,29 @@ class RayCaster:
             raise InvalidInputError(f"ray origins must be (3,) or ({count}, 3), got {start.shape}")
         limit = np.broadcast_to(np.asarray(max_range, dtype=np.float32), (count,))
         limit = np.ascontiguousarray(np.minimum(limit, np.float32(1e30)))
-        hits = self._scene.run(start32, dirs, dists=limit, output=1)
-        face = hits["primID"]
-        distance = hits["tfar"]
+        face, distance = self._run(start32, dirs, limit, threads)
         distance[face == NO_HIT] = np.inf
         return distance, face
+
+    def _run(
+        self, starts: NDArray, dirs: NDArray, limit: NDArray, threads: int
+    ) -> tuple[NDArray[np.int32], NDArray[np.float32]]:
+        if threads <= 1 or len(dirs) < 2 * MIN_RAYS_PER_THREAD:
+            hits = self._scene.run(starts, dirs, dists=limit, output=1)
+            return hits["primID"], hits["tfar"]
+        bounds = np.linspace(0, len(dirs), threads + 1).astype(int)
+        parts = [slice(a, b) for a, b in itertools.pairwise(bounds)]
+        hits = list(
+            _pool(threads).map(
+                lambda part: self._scene.run(starts[part], dirs[part], dists=limit[part], output=1),
+                parts,
+            )
+        )
+        face = np.concatenate([h["primID"] for h in hits])
+        distance = np.concatenate([h["tfar"] for h in hits])
+        return face, distance
+
+
+@cache
+def _pool(threads: int) -> ThreadPoolExecutor:
+    return ThreadPoolExecutor(threads, thread_name_prefix="embree")

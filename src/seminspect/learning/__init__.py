@@ -1,0 +1,1 @@
+"""Learned inspection (004): the semantic inspection environment, its policy and training."""
