@@ -185,3 +185,15 @@ def test_importing_the_package_does_not_load_torch() -> None:
     code = "import sys, seminspect.learning; assert 'torch' not in sys.modules"
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2] / "src")}
     subprocess.run([sys.executable, "-c", code], check=True, env=env)
+
+
+def test_frozen_stages_keep_their_random_projection() -> None:
+    small = make_policy(PolicyConfig.small())
+    for encoder in (small.map_encoder, small.depth_encoder):
+        first, second = (
+            m for m in encoder.convs if isinstance(m, torch.nn.Conv2d | torch.nn.Conv3d)
+        )
+        assert not first.weight.requires_grad and not first.bias.requires_grad
+        assert second.weight.requires_grad
+    paper = make_policy(PolicyConfig.paper())
+    assert all(p.requires_grad for p in paper.parameters())

@@ -45,7 +45,12 @@ Observation = Mapping[str, Tensor]
 
 class ConvStage(BaseModel):
     """One stage of a ResNet-style encoder: a convolution, an optional 3/2 max-pool (IMPALA),
-    then ``blocks`` residual blocks of two 3-wide convolutions at the stage's width."""
+    then ``blocks`` residual blocks of two 3-wide convolutions at the stage's width.
+
+    ``frozen`` keeps the stage's convolution at its random orthogonal initialisation (a fixed
+    projection of each patch): on a CPU the weight gradient of a strided convolution over the
+    full 21^3 maps or 54 x 96 image costs about ten times its forward pass (bench/rl_policy.py).
+    """
 
     model_config = ConfigDict(frozen=True, extra="forbid")
 
@@ -54,6 +59,7 @@ class ConvStage(BaseModel):
     stride: int = Field(1, gt=0)
     pool: bool = False
     blocks: int = Field(0, ge=0)
+    frozen: bool = False
 
 
 def _impala_stages(channels: tuple[int, ...]) -> tuple[ConvStage, ...]:
@@ -89,16 +95,17 @@ class PolicyConfig(BaseModel):
 
     @classmethod
     def small(cls, **changes: object) -> PolicyConfig:
-        """Sized to train on a 2-core CPU: two strided convolutions per encoder, MLP 256-128,
-        GRU 128 (bench/rl_policy.py times it). No residual blocks: on one CPU thread one block
-        at the coarsest grid doubled the encoders' time."""
+        """Sized to train on a 2-core CPU: two strided convolutions per encoder, the first a
+        fixed patch projection (``ConvStage.frozen``), MLP 256-128, GRU 128 (bench/rl_policy.py
+        times it). No residual blocks: on one CPU thread one block at the coarsest grid doubled
+        the encoders' time."""
         values: dict[str, object] = {
             "map_stages": (
-                ConvStage(channels=8, kernel=3, stride=3),
+                ConvStage(channels=8, kernel=3, stride=3, frozen=True),
                 ConvStage(channels=16, kernel=3, stride=2),
             ),
             "depth_stages": (
-                ConvStage(channels=8, kernel=4, stride=4),
+                ConvStage(channels=8, kernel=4, stride=4, frozen=True),
                 ConvStage(channels=16, kernel=3, stride=2),
             ),
             "latent_size": 64,
@@ -172,9 +179,9 @@ class ConvEncoder(nn.Module):
         channels = input_shape[0]
         for stage in stages:
             padding = stage.kernel // 2 if stage.stride == 1 else 0
-            layers.append(
-                _layer(conv(channels, stage.channels, stage.kernel, stage.stride, padding), 1.0)
-            )
+            first = _layer(conv(channels, stage.channels, stage.kernel, stage.stride, padding), 1.0)
+            first.requires_grad_(not stage.frozen)
+            layers.append(first)
             if stage.pool:
                 layers.append(pool(3, stride=2, padding=1))
             layers.extend(_Residual(conv, stage.channels, activation) for _ in range(stage.blocks))
