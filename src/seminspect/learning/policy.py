@@ -272,10 +272,13 @@ class InspectionPolicy(nn.Module):
         unclipped Gaussian sample, which is what PPO's ratio needs.
         """
         batch = obs["state"].shape[0]
-        step_starts = torch.zeros(1, batch) if starts is None else starts.view(1, batch)
+        device = self.log_std.device
+        step_starts = torch.zeros(1, batch, device=device) if starts is None else starts.view(1, -1)
         out = self({key: value.unsqueeze(0) for key, value in obs.items()}, hidden, step_starts)
         mean = out.mean[0]
-        noise = 0.0 if deterministic else torch.randn(mean.shape, generator=generator)
+        noise = (
+            0.0 if deterministic else torch.randn(mean.shape, generator=generator, device=device)
+        )
         raw = mean + out.log_std.exp() * noise
         log_prob = gaussian_log_prob(raw, mean, out.log_std)
         return ActionSample(raw.clamp(-1.0, 1.0), raw, log_prob, out.value[0], out.hidden)
