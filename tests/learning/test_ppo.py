@@ -18,6 +18,7 @@ from seminspect.learning.ppo import (
     ProgressRow,
     Rollout,
     TrainConfig,
+    _final_observations,
     advantages_gae,
     load_policy,
     read_checkpoint,
@@ -185,3 +186,18 @@ def test_checkpoints_of_other_kinds_or_networks_are_refused(tmp_path: Path) -> N
     broken = PolicyConfig.small().model_dump(mode="json") | {"gru_size": -3}
     with pytest.raises(SeminspectError, match="gru_size"):
         load_policy(forged(tmp_path, policy_config=broken))
+
+
+def test_final_observations_in_either_layout() -> None:
+    env = TargetReachEnv(3, seed=0)
+    obs, _ = env.reset(seed=0)
+    rows = np.array([False, True, True])
+    stacked = _final_observations({"final_obs": obs}, rows)
+    per_env = {key: np.empty(3, dtype=object) for key in obs}
+    for key, value in obs.items():
+        for row in range(3):
+            per_env[key][row] = value[row] if rows[row] else None
+    from_objects = _final_observations({"final_obs": per_env}, rows)
+    for key in obs:
+        np.testing.assert_array_equal(stacked[key], obs[key][1:])
+        np.testing.assert_array_equal(from_objects[key], obs[key][1:])

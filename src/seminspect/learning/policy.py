@@ -296,10 +296,12 @@ def gaussian_entropy(log_std: Tensor) -> Tensor:
     return (log_std + 0.5 * math.log(2 * math.pi * math.e)).sum()
 
 
-def as_tensors(obs: Mapping[str, np.ndarray]) -> dict[str, Tensor]:
-    """An environment's observation dict as float32 tensors (no copy where possible)."""
+def as_tensors(
+    obs: Mapping[str, np.ndarray], device: torch.device | str | None = None
+) -> dict[str, Tensor]:
+    """An environment's observation dict as float32 tensors (no copy on the CPU)."""
     check_observation(obs)
-    return {key: torch.as_tensor(obs[key], dtype=torch.float32) for key in _SHAPES}
+    return {key: torch.as_tensor(obs[key], dtype=torch.float32, device=device) for key in _SHAPES}
 
 
 def check_observation(obs: Mapping[str, np.ndarray]) -> None:

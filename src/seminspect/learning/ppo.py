@@ -196,16 +196,22 @@ class Rollout:
     next_start: Tensor = dataclasses.field(init=False)
 
     @classmethod
-    def empty(cls, steps: int, envs: int, hidden: int) -> Rollout:
+    def empty(
+        cls, steps: int, envs: int, hidden: int, device: torch.device | None = None
+    ) -> Rollout:
         shapes = {"state": (STATE_SIZE,), "depth": DEPTH_SHAPE, "maps": MAPS_SHAPE}
+
+        def zeros(*shape: int) -> Tensor:
+            return torch.zeros(*shape, device=device)
+
         return cls(
-            obs={key: torch.zeros(steps, envs, *shape) for key, shape in shapes.items()},
-            starts=torch.zeros(steps, envs),
-            raw_actions=torch.zeros(steps, envs, ACTION_SIZE),
-            log_probs=torch.zeros(steps, envs),
-            values=torch.zeros(steps, envs),
-            rewards=torch.zeros(steps, envs),
-            hidden0=torch.zeros(envs, hidden),
+            obs={key: zeros(steps, envs, *shape) for key, shape in shapes.items()},
+            starts=zeros(steps, envs),
+            raw_actions=zeros(steps, envs, ACTION_SIZE),
+            log_probs=zeros(steps, envs),
+            values=zeros(steps, envs),
+            rewards=zeros(steps, envs),
+            hidden0=zeros(envs, hidden),
         )
 
 
@@ -297,18 +303,21 @@ class _Run:
 
     def __init__(self, env: VectorEnv, policy: InspectionPolicy, config: TrainConfig):
         self.env, self.policy, self.config = env, policy, config
+        self.device = device = policy.log_std.device
         trainable = [parameter for parameter in policy.parameters() if parameter.requires_grad]
         self.optimizer = torch.optim.Adam(trainable, lr=config.lr, eps=1e-5)
-        self.sampler = torch.Generator().manual_seed(_torch_seed(config.seed, "actions"))
+        self.sampler = torch.Generator(device).manual_seed(_torch_seed(config.seed, "actions"))
         self.shuffle = make_rng(config.seed, "learning", "ppo", "minibatches")
         self.scaler = ReturnScaler(config.num_envs, config.gamma)
-        self.rollout = Rollout.empty(config.rollout_steps, config.num_envs, policy.config.gru_size)
+        self.rollout = Rollout.empty(
+            config.rollout_steps, config.num_envs, policy.config.gru_size, device
+        )
         self.steps = 0
         self.obstacles: int | None = None
         self._apply_curriculum()
         self.obs, _ = env.reset(seed=config.seed)
         self.hidden = policy.initial_state(config.num_envs)
-        self.starts = torch.ones(config.num_envs)
+        self.starts = torch.ones(config.num_envs, device=device)
 
     def _apply_curriculum(self) -> None:
         count = self.config.obstacles_at(self.steps / self.config.total_steps)
@@ -322,7 +331,7 @@ class _Run:
         stats, rollout, gamma = EpisodeStats(), self.rollout, self.config.gamma
         rollout.hidden0.copy_(self.hidden)
         for t in range(self.config.rollout_steps):
-            obs = as_tensors(self.obs)
+            obs = as_tensors(self.obs, self.device)
             for key, value in obs.items():
                 rollout.obs[key][t].copy_(value)
             sample = self.policy.act(obs, self.hidden, self.starts, generator=self.sampler)
@@ -330,7 +339,8 @@ class _Run:
             rollout.raw_actions[t] = sample.raw_action
             rollout.log_probs[t] = sample.log_prob
             rollout.values[t] = sample.value
-            self.obs, reward, terminated, truncated, info = self.env.step(sample.action.numpy())
+            actions = sample.action.cpu().numpy()
+            self.obs, reward, terminated, truncated, info = self.env.step(actions)
             done = np.logical_or(terminated, truncated)
             reward = np.asarray(reward, dtype=np.float64)
             if self.config.normalize_rewards:
@@ -338,13 +348,15 @@ class _Run:
             timed_out = np.logical_and(truncated, np.logical_not(terminated))
             if timed_out.any():
                 reward[timed_out] += gamma * self._values_of(
-                    _final_observations(info, timed_out), sample.hidden[timed_out]
+                    _final_observations(info, timed_out),
+                    sample.hidden[torch.as_tensor(timed_out, device=self.device)],
                 )
-            rollout.rewards[t] = torch.as_tensor(reward, dtype=torch.float32)
+            rollout.rewards[t] = torch.as_tensor(reward, dtype=torch.float32, device=self.device)
             stats.record(info)
             self.hidden = sample.hidden
-            self.starts = torch.as_tensor(done, dtype=torch.float32)
-        last = self.policy.act(as_tensors(self.obs), self.hidden, self.starts, deterministic=True)
+            self.starts = torch.as_tensor(done, dtype=torch.float32, device=self.device)
+        obs = as_tensors(self.obs, self.device)
+        last = self.policy.act(obs, self.hidden, self.starts, deterministic=True)
         rollout.next_value, rollout.next_start = last.value, self.starts.clone()
         self.steps += self.config.steps_per_update
         return stats
@@ -352,9 +364,9 @@ class _Run:
     @torch.no_grad()
     def _values_of(self, obs: Mapping[str, np.ndarray], hidden: Tensor) -> np.ndarray:
         """V of observations that end timed-out episodes, continuing their recurrent state."""
-        tensors = {key: value.unsqueeze(0) for key, value in as_tensors(obs).items()}
-        out = self.policy(tensors, hidden, torch.zeros(1, hidden.shape[0]))
-        return out.value[0].numpy().astype(np.float64)
+        tensors = {key: value.unsqueeze(0) for key, value in as_tensors(obs, self.device).items()}
+        out = self.policy(tensors, hidden, torch.zeros(1, hidden.shape[0], device=self.device))
+        return out.value[0].cpu().numpy().astype(np.float64)
 
     def update(self, progress: float) -> dict[str, float]:
         """PPO epochs over minibatches of whole env sequences; the GRU restarts from the state
@@ -369,7 +381,7 @@ class _Run:
         for _ in range(config.epochs):
             order = self.shuffle.permutation(config.num_envs)
             for first in range(0, config.num_envs, per_batch):
-                envs = torch.as_tensor(order[first : first + per_batch])
+                envs = torch.as_tensor(order[first : first + per_batch], device=self.device)
                 losses = self._minibatch_step(envs, advantages[:, envs], returns[:, envs])
                 for name, value in losses.items():
                     totals.setdefault(name, []).append(value)
@@ -516,9 +528,14 @@ def train(
     policy_config: PolicyConfig,
     train_config: TrainConfig,
     out_dir: str | Path,
+    *,
     progress: Callable[[ProgressRow], None] | None = None,
+    device: torch.device | str = "cpu",
 ) -> TrainResult:
     """Train a policy; ``make_env(num_envs, seed)`` builds the vector environment.
+
+    ``device`` holds the network and the rollout ("cuda" for the paper preset where a GPU is
+    available); the environment stays on the CPU. Only the CPU is tested here.
 
     Writes ``progress.csv``, TensorBoard events (with tensorboardX) and ``checkpoint.pt`` into
     ``out_dir``: every ``checkpoint_every`` steps, at the end, and on Ctrl-C or SIGTERM before
@@ -530,7 +547,7 @@ def train(
     threads = torch.get_num_threads()
     torch.set_num_threads(train_config.threads)
     torch.manual_seed(_torch_seed(train_config.seed, "init"))
-    policy = InspectionPolicy(policy_config)
+    policy = InspectionPolicy(policy_config).to(device)
     env = make_env(train_config.num_envs, train_config.seed)
     log = _ProgressLog(out)
     start = time.perf_counter()
