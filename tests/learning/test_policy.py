@@ -187,13 +187,15 @@ def test_importing_the_package_does_not_load_torch() -> None:
     subprocess.run([sys.executable, "-c", code], check=True, env=env)
 
 
-def test_frozen_stages_keep_their_random_projection() -> None:
+def test_small_preset_pools_its_inputs_before_convolving() -> None:
     small = make_policy(PolicyConfig.small())
-    for encoder in (small.map_encoder, small.depth_encoder):
-        first, second = (
-            m for m in encoder.convs if isinstance(m, torch.nn.Conv2d | torch.nn.Conv3d)
-        )
-        assert not first.weight.requires_grad and not first.bias.requires_grad
-        assert second.weight.requires_grad
+    assert isinstance(small.map_encoder.input_pool, torch.nn.MaxPool3d)
+    assert isinstance(small.depth_encoder.input_pool, torch.nn.AvgPool2d)
+    # A single occupied cell survives the max-pool of the maps: the encoder's output moves.
+    empty = torch.zeros(1, *MAPS_SHAPE)
+    one = empty.clone()
+    one[0, 0, 10, 10, 10] = 1.0
+    with torch.no_grad():
+        assert not torch.equal(small.map_encoder(empty), small.map_encoder(one))
     paper = make_policy(PolicyConfig.paper())
-    assert all(p.requires_grad for p in paper.parameters())
+    assert isinstance(paper.map_encoder.input_pool, torch.nn.Identity)

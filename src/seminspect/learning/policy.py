@@ -31,26 +31,19 @@ from pydantic import BaseModel, ConfigDict, Field
 from torch import Tensor, nn
 
 from seminspect.core.errors import InvalidInputError
+from seminspect.learning.env import ACTION_SIZE, STATE_SIZE, EnvConfig
 
-#: Input shapes of one environment's observation (the environment contract, 004 eq 4).
-STATE_SIZE = 17
-DEPTH_SHAPE = (1, 54, 96)
-MAPS_SHAPE = (2, 21, 21, 21)
+#: Input shapes of one environment's observation with the default sensors (004 eq 4).
+DEPTH_SHAPE = (1, EnvConfig().image_size[1], EnvConfig().image_size[0])
+MAPS_SHAPE = (2, *(EnvConfig().map_cells,) * 3)
 _SHAPES = {"state": (STATE_SIZE,), "depth": DEPTH_SHAPE, "maps": MAPS_SHAPE}
-#: a_t: three linear velocities and the yaw rate, each in [-1, 1] (004 eq 5).
-ACTION_SIZE = 4
 
 Observation = Mapping[str, Tensor]
 
 
 class ConvStage(BaseModel):
     """One stage of a ResNet-style encoder: a convolution, an optional 3/2 max-pool (IMPALA),
-    then ``blocks`` residual blocks of two 3-wide convolutions at the stage's width.
-
-    ``frozen`` keeps the stage's convolution at its random orthogonal initialisation (a fixed
-    projection of each patch): on a CPU the weight gradient of a strided convolution over the
-    full 21^3 maps or 54 x 96 image costs about ten times its forward pass (bench/rl_policy.py).
-    """
+    then ``blocks`` residual blocks of two 3-wide convolutions at the stage's width."""
 
     model_config = ConfigDict(frozen=True, extra="forbid")
 
@@ -59,7 +52,6 @@ class ConvStage(BaseModel):
     stride: int = Field(1, gt=0)
     pool: bool = False
     blocks: int = Field(0, ge=0)
-    frozen: bool = False
 
 
 def _impala_stages(channels: tuple[int, ...]) -> tuple[ConvStage, ...]:
@@ -78,6 +70,8 @@ class PolicyConfig(BaseModel):
     mlp_sizes: tuple[int, ...] = Field(min_length=1)
     gru_size: int = Field(ge=0, description="0: no GRU (004 Table III 'no GRU')")
     use_svs: bool = Field(True, description="False: the 3D encoder sees m^o only (Table II)")
+    map_pool: int = Field(1, ge=1, description="max-pool the maps by this factor first")
+    depth_pool: int = Field(1, ge=1, description="average-pool the depth image by this first")
     activation: Literal["elu"] = "elu"
     log_std_init: float = -0.5
 
@@ -95,19 +89,15 @@ class PolicyConfig(BaseModel):
 
     @classmethod
     def small(cls, **changes: object) -> PolicyConfig:
-        """Sized to train on a 2-core CPU: two strided convolutions per encoder, the first a
-        fixed patch projection (``ConvStage.frozen``), MLP 256-128, GRU 128 (bench/rl_policy.py
-        times it). No residual blocks: on one CPU thread one block at the coarsest grid doubled
-        the encoders' time."""
+        """Sized to train on a 2-core CPU: pool the inputs by 3 (0.3 m map blocks, d_coll's
+        size), one convolution per encoder, MLP 256-128, GRU 128. PyTorch's CPU 3D convolution
+        is slow to train (bench/rl_policy.py): pooling first keeps the 3D encoder and cuts its
+        cost several times."""
         values: dict[str, object] = {
-            "map_stages": (
-                ConvStage(channels=8, kernel=3, stride=3, frozen=True),
-                ConvStage(channels=16, kernel=3, stride=2),
-            ),
-            "depth_stages": (
-                ConvStage(channels=8, kernel=4, stride=4, frozen=True),
-                ConvStage(channels=16, kernel=3, stride=2),
-            ),
+            "map_stages": (ConvStage(channels=8, kernel=3, stride=1),),
+            "depth_stages": (ConvStage(channels=16, kernel=3, stride=2),),
+            "map_pool": 3,
+            "depth_pool": 3,
             "latent_size": 64,
             "mlp_sizes": (256, 128),
             "gru_size": 128,
@@ -170,18 +160,22 @@ class ConvEncoder(nn.Module):
         stages: tuple[ConvStage, ...],
         latent_size: int,
         activation: str,
+        input_pool: int = 1,
     ):
         super().__init__()
         dims = len(input_shape) - 1
         conv = nn.Conv3d if dims == 3 else nn.Conv2d
         pool = nn.MaxPool3d if dims == 3 else nn.MaxPool2d
+        # Maps keep "any obstacle in the block" (max); the depth image its mean range.
+        first = nn.MaxPool3d if dims == 3 else nn.AvgPool2d
+        self.input_pool = first(input_pool) if input_pool > 1 else nn.Identity()
         layers: list[nn.Module] = []
         channels = input_shape[0]
         for stage in stages:
             padding = stage.kernel // 2 if stage.stride == 1 else 0
-            first = _layer(conv(channels, stage.channels, stage.kernel, stage.stride, padding), 1.0)
-            first.requires_grad_(not stage.frozen)
-            layers.append(first)
+            layers.append(
+                _layer(conv(channels, stage.channels, stage.kernel, stage.stride, padding), 1.0)
+            )
             if stage.pool:
                 layers.append(pool(3, stride=2, padding=1))
             layers.extend(_Residual(conv, stage.channels, activation) for _ in range(stage.blocks))
@@ -189,13 +183,13 @@ class ConvEncoder(nn.Module):
         layers += [_activation(activation), nn.Flatten()]
         self.convs = nn.Sequential(*layers)
         with torch.no_grad():
-            flat = self.convs(torch.zeros(1, *input_shape)).shape[1]
+            flat = self.convs(self.input_pool(torch.zeros(1, *input_shape))).shape[1]
         self.latent = nn.Sequential(
             _layer(nn.Linear(flat, latent_size), math.sqrt(2)), _activation(activation)
         )
 
     def forward(self, x: Tensor) -> Tensor:
-        return self.latent(self.convs(x))
+        return self.latent(self.convs(self.input_pool(x)))
 
 
 class InspectionPolicy(nn.Module):
@@ -212,9 +206,15 @@ class InspectionPolicy(nn.Module):
         act = config.activation
         map_channels = MAPS_SHAPE[0] if config.use_svs else 1
         self.map_encoder = ConvEncoder(
-            (map_channels, *MAPS_SHAPE[1:]), config.map_stages, config.latent_size, act
+            (map_channels, *MAPS_SHAPE[1:]),
+            config.map_stages,
+            config.latent_size,
+            act,
+            input_pool=config.map_pool,
         )
-        self.depth_encoder = ConvEncoder(DEPTH_SHAPE, config.depth_stages, config.latent_size, act)
+        self.depth_encoder = ConvEncoder(
+            DEPTH_SHAPE, config.depth_stages, config.latent_size, act, input_pool=config.depth_pool
+        )
         layers: list[nn.Module] = []
         width = 2 * config.latent_size + STATE_SIZE
         for size in config.mlp_sizes:
