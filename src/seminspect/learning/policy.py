@@ -131,7 +131,8 @@ def _activation(name: str) -> nn.Module:
 def _layer(module: nn.Conv2d | nn.Conv3d | nn.Linear, gain: float) -> nn.Module:
     """Orthogonal weights and zero bias (the usual PPO initialisation)."""
     nn.init.orthogonal_(module.weight, gain)
-    nn.init.zeros_(module.bias)
+    if module.bias is not None:
+        nn.init.zeros_(module.bias)
     return module
 
 
