@@ -304,8 +304,7 @@ class _Run:
     def __init__(self, env: VectorEnv, policy: InspectionPolicy, config: TrainConfig):
         self.env, self.policy, self.config = env, policy, config
         self.device = device = policy.log_std.device
-        trainable = [parameter for parameter in policy.parameters() if parameter.requires_grad]
-        self.optimizer = torch.optim.Adam(trainable, lr=config.lr, eps=1e-5)
+        self.optimizer = torch.optim.Adam(policy.parameters(), lr=config.lr, eps=1e-5)
         self.sampler = torch.Generator(device).manual_seed(_torch_seed(config.seed, "actions"))
         self.shuffle = make_rng(config.seed, "learning", "ppo", "minibatches")
         self.scaler = ReturnScaler(config.num_envs, config.gamma)
