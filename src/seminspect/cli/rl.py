@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from seminspect.cli._common import console, err_console
+from seminspect.cli._common import console, progress_bar
 
 app = typer.Typer(no_args_is_help=True, help="Learned semantic inspection in rooms (004).")
 
@@ -66,25 +66,6 @@ def _policy_name(policy: str | None) -> str:
     return "shipped" if policy is None else Path(policy).name
 
 
-def _progress_bar():
-    from rich.progress import (
-        BarColumn,
-        Progress,
-        TextColumn,
-        TimeElapsedColumn,
-        TimeRemainingColumn,
-    )
-
-    return Progress(
-        TextColumn("[bold]{task.description}"),
-        BarColumn(),
-        TimeElapsedColumn(),
-        TimeRemainingColumn(),
-        console=err_console,
-        transient=True,
-    )
-
-
 @app.command("eval")
 def eval_command(
     policy: str | None = _POLICY,
@@ -111,7 +92,7 @@ def eval_command(
     controller = controller_for(policy, seed)
     name = _policy_name(policy)
     traces: dict[int, EpisodeTrace] = {}
-    with _progress_bar() as bar:
+    with progress_bar() as bar:
         task = bar.add_task(f"{name}", total=1.0)
 
         def show(label: str, share: float) -> None:
@@ -180,7 +161,7 @@ def show_command(
     obs, _ = env.reset(seed=seed)
     controller.reset(env)
     crashed = False
-    with _progress_bar() as bar:
+    with progress_bar() as bar:
         task = bar.add_task("episode", total=config.steps_per_episode)
         for _ in range(config.steps_per_episode):
             obs, _, crash, _, _ = env.step(controller.act(env, obs))
