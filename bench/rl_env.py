@@ -26,7 +26,7 @@ from seminspect.learning.baselines import OrbitController, RandomController
 from seminspect.learning.env import EnvConfig, InspectionVectorEnv, _sensor_rays
 
 #: Timed steps per room count: about the same number of room-steps for each.
-STEPS = {1: 300, 8: 60, 64: 12}
+STEPS = {1: 600, 8: 150, 64: 40}
 
 
 def step_rate(env: InspectionVectorEnv, controller, steps: int) -> float:
