@@ -81,6 +81,7 @@ class EvaluationResult(BaseModel):
     policy: str
     seed: int
     num_envs: int
+    #: The environment's settings; each row replaces ``obstacles`` with its own count.
     config: EnvConfig
     wall_seconds: float
     results: list[ObstacleResult]
