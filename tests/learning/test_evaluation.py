@@ -70,7 +70,13 @@ def test_the_result_round_trips_through_json(runs, tmp_path):
 
 @pytest.mark.parametrize(
     ("counts", "episodes", "message"),
-    [([], 1, "at least one"), ([0, 0], 1, "repeat"), ([-1], 1, ">= 0"), ([0], 0, "episodes")],
+    [
+        ([], 1, "at least one"),
+        ([0, 0], 1, "repeat"),
+        ([-1], 1, ">= 0"),
+        ([0], 0, "episodes"),
+        ([61], 1, "obstacles"),
+    ],
 )
 def test_bad_protocols_are_refused(counts, episodes, message):
     with pytest.raises(InvalidInputError, match=message):

@@ -27,7 +27,7 @@ from pydantic import BaseModel, ConfigDict, ValidationError
 from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.core.io import read_versioned_json, write_versioned_json
 from seminspect.core.rng import make_rng
-from seminspect.core.validation import describe_validation_error
+from seminspect.core.validation import build, describe_validation_error
 from seminspect.learning.baselines import Controller
 from seminspect.learning.env import EnvConfig, InspectionVectorEnv
 from seminspect.learning.rooms import Room
@@ -186,7 +186,7 @@ def evaluate(
     started = time.perf_counter()
     results = []
     for obstacles in counts:
-        cfg = base.model_copy(update={"obstacles": obstacles})
+        cfg = build(EnvConfig, {**base.model_dump(), "obstacles": obstacles}, "environment")
         tally = _Tally()
         for batch, first in enumerate(range(0, episodes, num_envs)):
             size = min(num_envs, episodes - first)
