@@ -38,6 +38,7 @@ GROUPS: tuple[tuple[str, str, str], ...] = (
     ("world", "world", "List, draw and export the built-in simulated worlds."),
     ("bench", "bench", "Studies that reproduce the papers' comparisons (planning: 000 Table 5)."),
     ("sweep", "sweep", "Many missions (worlds x scenarios x seeds x settings) on Ray, one table."),
+    ("rl", "rl", "Learned semantic inspection in rooms: evaluate and show (paper 004)."),
     ("view", "view", "Open a run's report.html (3D graph, tables, plots) in the browser."),
 )
 

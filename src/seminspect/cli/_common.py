@@ -23,6 +23,19 @@ def labelled(label: str, style: str, message: object) -> Text:
     return Text.assemble((label, style), " ", str(message))
 
 
+def progress_bar():
+    """A transient rich progress bar on stderr: description, bar, elapsed time."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    return Progress(
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        TimeElapsedColumn(),
+        console=err_console,
+        transient=True,
+    )
+
+
 def writable_file(path: Path, suffixes: tuple[str, ...] = ()) -> Path:
     """Check, before any work, that ``path`` can be written as a file (of one of ``suffixes``)."""
     if path.is_dir():

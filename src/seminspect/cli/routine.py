@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from seminspect.cli._common import console, err_console
+from seminspect.cli._common import console, err_console, progress_bar
 
 app = typer.Typer(no_args_is_help=True, help="Routine inspection on an outdated map (002).")
 
@@ -42,18 +42,6 @@ def _config_and_site(world, scenario, seed, length, historical, current, *, need
     return RoutineConfig(world="user", scenario="user", seed=seed, length=length), site
 
 
-def _progress_bar():
-    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
-
-    return Progress(
-        TextColumn("[bold]{task.description}"),
-        BarColumn(),
-        TimeElapsedColumn(),
-        console=err_console,
-        transient=True,
-    )
-
-
 @app.command("map")
 def map_command(
     world: str = _WORLD,
@@ -69,7 +57,7 @@ def map_command(
     config, site = _config_and_site(
         world, scenario, seed, length, historical, None, need_current=False
     )
-    with _progress_bar() as bar:
+    with progress_bar() as bar:
         task = bar.add_task("mapping M_H", total=1.0)
         path = map_site(config, out, lambda share: bar.update(task, completed=share), site)
     console.print(f"M_H recorded: {path}")
@@ -108,7 +96,7 @@ def inspect_command(
     runs = {"adaptive": True, "baseline": False} if compare else {"": adapt}
     results = {}
     shared_prior = prior
-    with _progress_bar() as bar:
+    with progress_bar() as bar:
         for name, adaptive in runs.items():
             task = bar.add_task(name or "inspection", total=1.0)
 

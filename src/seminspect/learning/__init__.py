@@ -1,14 +1,20 @@
 """Learned inspection: the semantic deep-RL planner of paper 004.
 
-The policy network (``learning.policy``: 004 Sec III-D, Fig 2) and its recurrent PPO trainer
-(``learning.ppo``). Both need torch (the ``rl`` extra); the names below are imported on first
-use so that importing the package, or its environment, does not load torch.
+The rooms and vector environment, baselines and evaluation need only numpy and gymnasium. The
+policy network (``learning.policy``: 004 Sec III-D, Fig 2) and its recurrent PPO trainer
+(``learning.ppo``) need torch (the ``rl`` extra); those names are imported on first use, so
+importing the package, or its environment, does not load torch.
 """
 
 from __future__ import annotations
 
 import importlib
 from typing import Any
+
+from seminspect.learning.baselines import Controller, OrbitController, RandomController
+from seminspect.learning.env import EnvConfig, InspectionEnv, InspectionVectorEnv
+from seminspect.learning.evaluation import EpisodeTrace, EvaluationResult, evaluate
+from seminspect.learning.rooms import Room, sample_room
 
 #: Public name -> the module that defines it (imported lazily: torch is an optional extra).
 _LAZY = {
@@ -17,9 +23,30 @@ _LAZY = {
     "load_policy": "seminspect.learning.ppo",
     "train": "seminspect.learning.ppo",
     "TrainConfig": "seminspect.learning.ppo",
+    "LearnedController": "seminspect.learning.agent",
+    "load_controller": "seminspect.learning.agent",
 }
 
-__all__ = ["InspectionPolicy", "PolicyConfig", "TrainConfig", "load_policy", "train"]
+__all__ = [
+    "Controller",
+    "EnvConfig",
+    "EpisodeTrace",
+    "EvaluationResult",
+    "InspectionEnv",
+    "InspectionPolicy",
+    "InspectionVectorEnv",
+    "LearnedController",
+    "OrbitController",
+    "PolicyConfig",
+    "RandomController",
+    "Room",
+    "TrainConfig",
+    "evaluate",
+    "load_controller",
+    "load_policy",
+    "sample_room",
+    "train",
+]
 
 
 def __getattr__(name: str) -> Any:

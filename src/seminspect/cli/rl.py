@@ -1,0 +1,177 @@
+"""``seminspect rl``: the learned inspection policy of 004 and its baselines in random rooms."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from seminspect.cli._common import console, progress_bar
+
+app = typer.Typer(no_args_is_help=True, help="Learned semantic inspection in rooms (004).")
+
+#: Controllers known by name; anything else is a checkpoint file.
+BASELINES = ("random", "orbit")
+
+_POLICY = typer.Option(
+    None,
+    "--policy",
+    "-p",
+    help="random, orbit, or a policy checkpoint file; default: the shipped policy.",
+)
+_SEED = typer.Option(0, "--seed", help="Seed of the rooms, noise and random policy.", min=0)
+_ENVS = typer.Option(64, "--envs", help="Rooms stepped together.", min=1, max=512)
+_THREADS = typer.Option(1, "--threads", help="Ray-casting threads.", min=1, max=64)
+
+
+def parse_obstacles(text: str) -> list[int]:
+    """``"0,4,9"`` -> ``[0, 4, 9]``: distinct non-negative counts within the rooms' limit."""
+    from seminspect.core.errors import InvalidInputError
+    from seminspect.learning.env import EnvConfig
+
+    limit = EnvConfig.model_fields["obstacles"].metadata
+    most = next(m.le for m in limit if hasattr(m, "le"))
+    try:
+        counts = [int(part) for part in text.split(",")]
+    except ValueError:
+        raise InvalidInputError(
+            f"--obstacles must be comma-separated whole numbers like 0,4,9, got {text!r}"
+        ) from None
+    if any(not 0 <= k <= most for k in counts):
+        raise InvalidInputError(f"--obstacles must lie in 0-{most}, got {text!r}")
+    if len(set(counts)) != len(counts):
+        raise InvalidInputError(f"--obstacles repeats a count: {text!r}")
+    return counts
+
+
+def controller_for(policy: str | None, seed: int):
+    """The baseline named ``policy``, or the learned policy from a checkpoint (None: shipped)."""
+    from seminspect.core.errors import InvalidInputError
+    from seminspect.learning.baselines import OrbitController, RandomController
+
+    if policy == "random":
+        return RandomController(seed)
+    if policy == "orbit":
+        return OrbitController()
+    if policy is not None and not Path(policy).is_file():
+        raise InvalidInputError(
+            f"unknown policy {policy!r}: use {', '.join(BASELINES)} or a checkpoint file"
+        )
+    from seminspect.learning.agent import load_controller
+
+    return load_controller(None if policy is None else Path(policy))
+
+
+def _policy_name(policy: str | None) -> str:
+    return "shipped" if policy is None else Path(policy).name
+
+
+@app.command("eval")
+def eval_command(
+    policy: str | None = _POLICY,
+    obstacles: str = typer.Option(
+        "0,4,9,14,19", "--obstacles", help="Comma-separated obstacle counts (004 Table I)."
+    ),
+    episodes: int = typer.Option(20, "--episodes", "-n", help="Episodes per obstacle count."),
+    seed: int = _SEED,
+    envs: int = _ENVS,
+    threads: int = _THREADS,
+    out: Path = typer.Option(..., "--out", "-o", help="Directory for evaluation.json and PNGs."),
+) -> None:
+    """Coverage, crash % and timeout % per obstacle count, beside 004 Table I."""
+    from seminspect.cli._common import writable_directory
+    from seminspect.core.errors import InvalidInputError
+    from seminspect.learning.evaluation import EpisodeTrace, evaluate
+    from seminspect.report.figures import save_figure
+    from seminspect.report.rl import coverage_figure, write_episode_pictures
+
+    counts = parse_obstacles(obstacles)
+    if episodes < 1:
+        raise InvalidInputError(f"--episodes must be at least 1, got {episodes}")
+    writable_directory(out)
+    controller = controller_for(policy, seed)
+    name = _policy_name(policy)
+    traces: dict[int, EpisodeTrace] = {}
+    with progress_bar() as bar:
+        task = bar.add_task(f"{name}", total=1.0)
+
+        def show(label: str, share: float) -> None:
+            bar.update(task, completed=share, description=f"{name}: {label}")
+
+        result = evaluate(
+            controller,
+            counts,
+            episodes,
+            seed,
+            num_envs=envs,
+            progress=show,
+            policy=name,
+            threads=threads,
+            traces=traces,
+        )
+    result.to_json(out / "evaluation.json")
+    save_figure(coverage_figure({name: result}), out / "coverage.png")
+    for count, trace in traces.items():
+        write_episode_pictures(
+            trace,
+            result.config.model_copy(update={"obstacles": count}),
+            out,
+            prefix=f"episode_{count:02d}",
+            title=f"{name}, {count} obstacles",
+        )
+    _print_table(result)
+    console.print(f"{result.wall_seconds:.1f} s; results: {out} (evaluation.json, *.png)")
+
+
+def _print_table(result) -> None:
+    from rich.table import Table
+
+    from seminspect.learning.evaluation import PAPER_TABLE1
+
+    table = Table(title=f"{result.policy}: {result.results[0].episodes} episodes per row")
+    for header in ("obstacles", "coverage %", "004", "crash %", "004", "timeout %", "004"):
+        table.add_column(header, justify="right")
+    for row in result.results:
+        paper = PAPER_TABLE1.get(row.obstacles)
+        ours = (row.coverage_pct, row.crash_pct, row.timeout_pct)
+        cells = [str(row.obstacles)]
+        for k, value in enumerate(ours):
+            cells += [f"{value:.1f}", "-" if paper is None else f"{paper[k]:.1f}"]
+        table.add_row(*cells)
+    console.print(table)
+
+
+@app.command("show")
+def show_command(
+    policy: str | None = _POLICY,
+    obstacles: int = typer.Option(9, "--obstacles", help="Obstacles in the room.", min=0, max=60),
+    seed: int = _SEED,
+    out: Path = typer.Option(..., "--out", "-o", help="Directory for the episode's PNGs."),
+) -> None:
+    """Fly one recorded episode and draw it (top-down, 3D, coverage against time)."""
+    from seminspect.cli._common import writable_directory
+    from seminspect.learning.env import EnvConfig, InspectionVectorEnv
+    from seminspect.learning.evaluation import EpisodeTrace
+    from seminspect.report.rl import write_episode_pictures
+
+    writable_directory(out)
+    controller = controller_for(policy, seed)
+    config = EnvConfig(obstacles=obstacles)
+    env = InspectionVectorEnv(1, config, seed=seed, autoreset=False, record=True)
+    obs, _ = env.reset(seed=seed)
+    controller.reset(env)
+    crashed = False
+    with progress_bar() as bar:
+        task = bar.add_task("episode", total=config.steps_per_episode)
+        for _ in range(config.steps_per_episode):
+            obs, _, crash, _, _ = env.step(controller.act(env, obs))
+            crashed = bool(crash[0])
+            if crashed:
+                break
+            bar.advance(task)
+    trace = EpisodeTrace(env.rooms[0], env.track(0), env.face_distances(0), crashed)
+    name = _policy_name(policy)
+    written = write_episode_pictures(trace, config, out, title=f"{name}, {obstacles} obstacles")
+    ending = "crashed" if crashed else "timeout (no crash)"
+    console.print(f"coverage {100.0 * env.coverage()[0]:.1f} %, {ending}")
+    console.print(f"pictures: {', '.join(str(p) for p in written)}")

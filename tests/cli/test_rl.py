@@ -1,0 +1,56 @@
+"""``seminspect rl``: evaluate and show baselines, and one-line errors."""
+
+import pytest
+
+from cli_runner import run
+from seminspect.learning.evaluation import EvaluationResult
+
+
+def test_eval_writes_the_json_the_pictures_and_a_table_beside_table_1(capsys, tmp_path):
+    out = tmp_path / "eval"
+    code, stdout, err = run(
+        capsys, "rl", "eval", "--policy", "orbit", "--obstacles", "0,4", "--episodes", "1",
+        "--envs", "1", "--out", str(out),
+    )  # fmt: skip
+    assert code == 0, err
+    result = EvaluationResult.from_json(out / "evaluation.json")
+    assert [r.obstacles for r in result.results] == [0, 4]
+    assert result.policy == "orbit" and result.at(0).episodes == 1
+    assert (out / "coverage.png").exists() and (out / "episode_04_3d.png").exists()
+    assert "92.1" in stdout and "82.6" in stdout  # 004 Table I beside ours
+    assert f"{result.at(0).coverage_pct:.1f}" in stdout
+
+
+def test_show_draws_one_episode(capsys, tmp_path):
+    code, stdout, err = run(
+        capsys, "rl", "show", "--policy", "random", "--obstacles", "0", "--out", str(tmp_path)
+    )
+    assert code == 0, err
+    assert "coverage" in stdout
+    assert {p.name for p in tmp_path.iterdir()} == {
+        "episode_top.png", "episode_3d.png", "episode_coverage.png"
+    }  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--obstacles", "0,a"], "comma-separated whole numbers"),
+        (["--obstacles", "4,4"], "repeats"),
+        (["--obstacles", "0,99"], "must lie in 0-60"),
+        (["--episodes", "0"], "--episodes must be at least 1"),
+        (["--policy", "greedy"], "unknown policy 'greedy'"),
+    ],
+)
+def test_bad_input_is_one_line_and_exit_1(capsys, tmp_path, args, message):
+    code, _, err = run(capsys, "rl", "eval", *args, "--out", str(tmp_path / "x"))
+    assert code == 1
+    assert message in err and "Traceback" not in err
+    assert len(err.strip().splitlines()) <= 2  # rich may wrap the one line
+
+
+def test_an_unwritable_out_is_refused_before_any_work(capsys, tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    code, _, err = run(capsys, "rl", "eval", "--policy", "random", "--out", str(blocker))
+    assert code == 1 and "not a directory" in err

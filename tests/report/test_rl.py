@@ -1,0 +1,61 @@
+"""Pictures of learned-inspection episodes and evaluations."""
+
+import math
+
+import numpy as np
+import pytest
+
+from seminspect.learning.baselines import OrbitController, RandomController
+from seminspect.learning.env import EnvConfig
+from seminspect.learning.evaluation import evaluate
+from seminspect.learning.rooms import BOX, CYLINDER, TARGET_FACES
+from seminspect.report.rl import (
+    coverage_figure,
+    face_states,
+    solid_outline,
+    write_episode_pictures,
+)
+
+SHORT = EnvConfig(episode_seconds=2.0)
+
+
+def test_face_states_split_covered_far_and_unseen():
+    distances = np.array([1.0, 3.0, 3.5, np.inf])
+    np.testing.assert_array_equal(face_states(distances, 3.0), [2, 2, 1, 0])
+
+
+def test_outlines_are_the_footprints_of_rotated_solids():
+    quarter = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])  # 90 deg about z
+    box = solid_outline(BOX, np.array([5.0, 5.0, 1.0]), quarter, np.array([2.0, 1.0, 0.5]))
+    np.testing.assert_allclose(np.sort(np.unique(box[:, 0])), [4.0, 6.0], atol=1e-12)
+    np.testing.assert_allclose(np.sort(np.unique(box[:, 1])), [3.0, 7.0], atol=1e-12)
+    lying = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # axis along y
+    cylinder = solid_outline(CYLINDER, np.zeros(3), lying, np.array([0.5, 2.0, 0.0]))
+    assert cylinder[:, 0].max() == pytest.approx(0.5)
+    assert cylinder[:, 1].max() == pytest.approx(2.0)
+
+
+@pytest.fixture(scope="module")
+def evaluations():
+    traces = {}
+    orbit = evaluate(OrbitController(), [0, 4], 2, seed=0, config=SHORT, num_envs=2,
+                     policy="orbit", traces=traces)  # fmt: skip
+    random = evaluate(RandomController(), [0, 4], 2, seed=0, config=SHORT, num_envs=2)
+    return {"orbit": orbit, "random": random}, traces
+
+
+def test_episode_pictures_are_written(evaluations, tmp_path):
+    _, traces = evaluations
+    written = write_episode_pictures(traces[4], SHORT, tmp_path, prefix="k4", title="orbit")
+    assert [p.name for p in written] == ["k4_top.png", "k4_3d.png", "k4_coverage.png"]
+    assert all(p.stat().st_size > 10_000 for p in written)
+    assert len(traces[4].face_distances) == TARGET_FACES
+
+
+def test_coverage_against_time_has_a_line_per_controller_and_a_panel_per_count(evaluations):
+    results, _ = evaluations
+    figure = coverage_figure(results)
+    assert [ax.get_title() for ax in figure.axes] == ["0 obstacles", "4 obstacles"]
+    for ax in figure.axes:
+        assert [line.get_label() for line in ax.get_lines()] == ["orbit", "random"]
+        assert math.isclose(ax.get_ylim()[1], 100.0)
