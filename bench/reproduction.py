@@ -9,7 +9,9 @@ document; the prose and the paper's own rows around them are left as written. Se
 * ``table5``, ``targets``: 000 Table 5 on the city seed-0 runs of the same missions (queries
   answered by both planners, the volumetric one over the ground band and the full volume);
 * ``scaling``: the synthetic-city scaling study (000 Fig 13 analogue);
-* ``table6``: 000 Table 6, each city scenario with both planners over seeds 0-2.
+* ``table6``: 000 Table 6, each city scenario with both planners over seeds 0-2;
+* ``rl-table1``, ``rl-table2``, ``rl-table3``: 004 Tables I-III from ``bench/rl_reproduction.py``
+  (the shipped policy, its ablations and the baselines, 100 episodes per obstacle count).
 
 Mission runs go under ``--runs`` and are reused when a completed run of the same configuration
 is there (``--fresh`` deletes them first, so every figure comes from a new run).
@@ -26,6 +28,8 @@ from pathlib import Path
 
 from mission_acceptance import CITY, HEADER, OTHERS, acceptance_lines, row, run_acceptance
 from planning_targets import targets_markdown, targets_met
+from rl_reproduction import SECTIONS as RL_SECTIONS
+from rl_reproduction import regenerate as rl_regenerate
 from seminspect.report.markdown import rewrite_sections
 from seminspect.studies.planning.scaling import SCALING_SIZES, scaling_study
 from seminspect.studies.planning.study import PlanningStudy, compare_run, mission_study
@@ -38,7 +42,16 @@ from seminspect.studies.planning.tables import (
 
 SCENARIOS = ("small", "medium", "large")
 CITY_SECTIONS = tuple(f"table3-city-{scenario}" for scenario in SCENARIOS)
-SECTIONS = (*CITY_SECTIONS, "acceptance", "table3-others", "table5", "targets", "scaling", "table6")
+SECTIONS = (
+    *CITY_SECTIONS,
+    "acceptance",
+    "table3-others",
+    "table5",
+    "targets",
+    "scaling",
+    "table6",
+    *RL_SECTIONS,
+)
 DOC = Path(__file__).resolve().parents[1] / "docs" / "reproduction.md"
 
 
@@ -144,6 +157,8 @@ def main() -> None:
         shutil.rmtree(args.runs)
     sections, seed0 = table3_sections(args.runs, wanted)
     sections |= planning_sections(args.runs, seed0, wanted, args.table6_scenario or list(SCENARIOS))
+    if wanted & set(RL_SECTIONS):
+        sections |= rl_regenerate(wanted & set(RL_SECTIONS))
     rewrite_sections(args.doc, sections)
     log(f"rewrote {', '.join(sorted(sections))} in {args.doc}")
 

@@ -54,3 +54,36 @@ def test_an_unwritable_out_is_refused_before_any_work(capsys, tmp_path):
     blocker.write_text("")
     code, _, err = run(capsys, "rl", "eval", "--policy", "random", "--out", str(blocker))
     assert code == 1 and "not a directory" in err
+
+
+def test_train_writes_a_checkpoint_that_eval_can_fly(capsys, tmp_path):
+    run_dir = tmp_path / "run"
+    code, stdout, err = run(
+        capsys, "rl", "train", "--steps", "256", "--envs", "4", "--out", str(run_dir)
+    )
+    assert code == 0, err
+    assert (run_dir / "checkpoint.pt").is_file() and (run_dir / "progress.csv").is_file()
+    assert "256 steps" in stdout
+    code, _, err = run(
+        capsys, "rl", "eval", "--policy", str(run_dir / "checkpoint.pt"), "--obstacles", "0",
+        "--episodes", "1", "--envs", "1", "--out", str(tmp_path / "eval"),
+    )  # fmt: skip
+    assert code == 0, err
+    assert EvaluationResult.from_json(tmp_path / "eval" / "evaluation.json").at(0).episodes == 1
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--variant", "gru9"], "unknown variant 'gru9'"),
+        (["--config", "huge"], "unknown network size 'huge'"),
+        (["--envs", "6"], "multiple of minibatches"),
+        (["--device", "gpu"], "not a torch device"),
+        (["--steps", "0"], "--steps must be at least 1"),
+    ],
+)
+def test_train_refuses_bad_settings_in_one_line(capsys, tmp_path, args, message):
+    code, _, err = run(capsys, "rl", "train", *args, "--out", str(tmp_path / "x"))
+    assert code == 1
+    assert message in err and "Traceback" not in err
+    assert not (tmp_path / "x" / "checkpoint.pt").exists()

@@ -152,3 +152,14 @@ def test_masked_depth_is_the_full_render_on_target_pixels_only(empty_room_env):
     kept = ray[ray < len(camera)]
     assert set(np.flatnonzero(on_target)) <= set(kept.tolist())
     assert len(kept) < len(camera)  # and it does prune
+
+
+def test_stepping_after_every_room_ended_changes_nothing():
+    env = InspectionVectorEnv(2, EnvConfig(obstacles=0, episode_seconds=0.2), autoreset=False)
+    env.reset(seed=3)
+    for _ in range(2):
+        env.step(np.zeros((2, 4), dtype=np.float32))
+    before = env.positions()
+    obs, reward, crash, timeout, _ = env.step(np.ones((2, 4), dtype=np.float32))
+    assert np.array_equal(env.positions(), before)
+    assert not reward.any() and not crash.any() and not timeout.any()

@@ -175,3 +175,66 @@ def show_command(
     ending = "crashed" if crashed else "timeout (no crash)"
     console.print(f"coverage {100.0 * env.coverage()[0]:.1f} %, {ending}")
     console.print(f"pictures: {', '.join(str(p) for p in written)}")
+
+
+@app.command("train")
+def train_command(
+    config: str = typer.Option(
+        "small", "--config", help="Network: small (sized for a CPU) or paper (004 Fig 2)."
+    ),
+    variant: str = typer.Option(
+        "main", "--variant", help="main, no-svs (Table II) or no-gru (Table III)."
+    ),
+    steps: int = typer.Option(640_000, "--steps", help="Environment steps, all rooms together."),
+    seed: int = _SEED,
+    envs: int = typer.Option(64, "--envs", help="Rooms stepped together.", min=1, max=512),
+    device: str = typer.Option("cpu", "--device", help="Torch device for the network (cpu, cuda)."),
+    out: Path = typer.Option(..., "--out", "-o", help="Directory for checkpoint.pt and logs."),
+) -> None:
+    """Train a policy with recurrent PPO and the obstacle curriculum; Ctrl-C keeps a checkpoint."""
+    from seminspect.cli._common import writable_directory
+    from seminspect.core.errors import InvalidInputError
+    from seminspect.learning.env import InspectionVectorEnv
+    from seminspect.learning.ppo import ProgressRow, train
+    from seminspect.learning.recipes import policy_config, train_config, training_env_config
+
+    if steps < 1:
+        raise InvalidInputError(f"--steps must be at least 1, got {steps}")
+    _check_device(device)
+    network = policy_config(config, variant)  # type: ignore[arg-type]
+    settings = train_config(steps, seed=seed, num_envs=envs)
+    rooms = training_env_config(network)
+    writable_directory(out)
+
+    def make_env(count: int, env_seed: int) -> InspectionVectorEnv:
+        return InspectionVectorEnv(count, rooms, seed=env_seed)
+
+    with progress_bar() as bar:
+        task = bar.add_task(f"{config}/{variant}", total=steps)
+
+        def show(row: ProgressRow) -> None:
+            coverage = "" if row.episodes == 0 else f", coverage {row.coverage_pct:.0f} %"
+            label = f"{config}/{variant}: {row.steps_per_s:.0f} steps/s{coverage}"
+            bar.update(task, completed=min(row.steps, steps), description=label)
+
+        result = train(make_env, network, settings, out, progress=show, device=device)
+    console.print(
+        f"{result.steps:,} steps in {result.wall_s / 60:.1f} min; "
+        f"checkpoint: {result.checkpoint} (progress.csv beside it)"
+    )
+
+
+def _check_device(name: str) -> None:
+    """A torch device that exists here: ``cpu``, or ``cuda`` when a GPU is visible."""
+    import torch
+
+    from seminspect.core.errors import InvalidInputError
+
+    try:
+        kind = torch.device(name).type
+    except RuntimeError:
+        raise InvalidInputError(f"--device {name!r} is not a torch device (cpu, cuda)") from None
+    if kind == "cuda" and not torch.cuda.is_available():
+        raise InvalidInputError("--device cuda: no CUDA device is visible on this machine")
+    if kind not in ("cpu", "cuda"):
+        raise InvalidInputError(f"--device {name!r}: only cpu and cuda are supported")

@@ -504,12 +504,13 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
             raise InvalidInputError("actions must be finite")
         act = np.clip(act, -1.0, 1.0)
         live = np.flatnonzero(~self._done)
-        self._move(live, act)
-        self._steps[live] += 1
         reward = np.zeros(self.num_envs)
-        reward[live] = self._sense(live)
         crash = np.zeros(self.num_envs, dtype=bool)
-        crash[live] = self._crashed(live)
+        if len(live):  # without autoreset every room may have ended already
+            self._move(live, act)
+            self._steps[live] += 1
+            reward[live] = self._sense(live)
+            crash[live] = self._crashed(live)
         reward[crash] -= self.config.crash_penalty
         timeout = ~crash & (self._steps >= self.config.steps_per_episode)
         timeout &= ~self._done

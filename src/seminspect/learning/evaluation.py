@@ -42,6 +42,17 @@ PAPER_TABLE1: dict[int, tuple[float, float, float]] = {
     14: (64.2, 1.5, 98.5),
     19: (58.1, 1.3, 98.7),
 }
+#: 004 Table II (9 obstacles): coverage %, crash %, timeout % without and with the SVS map.
+PAPER_TABLE2: dict[str, tuple[float, float, float]] = {
+    "m^o": (52.3, 1.0, 99.0),
+    "m^o & m^h": (74.6, 1.2, 98.8),
+}
+#: 004 Table III (9 obstacles): the same without a GRU and with GRUs of 128 and 512 units.
+PAPER_TABLE3: dict[str, tuple[float, float, float]] = {
+    "no GRU": (59.8, 3.6, 96.4),
+    "GRU 128": (63.6, 1.1, 99.1),
+    "GRU 512": (74.6, 1.2, 98.8),
+}
 #: Coverage curves are kept at this interval (s), and in full for this many episodes per K.
 CURVE_INTERVAL = 1.0
 KEPT_CURVES = 4

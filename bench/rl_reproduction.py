@@ -1,0 +1,118 @@
+"""004 Tables I-III with the shipped policy, its ablations and the baselines, beside the paper.
+
+Every controller meets the same rooms (seed 0, 100 episodes per obstacle count, 90 s each; the
+rooms are drawn per batch and per room, see ``learning.evaluation``). The evaluations are kept
+as JSON in ``docs/data/rl/``; the tables of docs/reproduction.md are made from those files, and
+``tests/report/test_rl_tables.py`` checks that the document still matches them.
+
+* ``rl-table1``: the shipped policy, the orbit and the random controllers at 0/4/9/14/19
+  obstacles (004 Table I);
+* ``rl-table2``: the policy trained without the SVS map beside the shipped one, 9 obstacles;
+* ``rl-table3``: the policy trained without a GRU beside the shipped one (GRU 128), 9 obstacles.
+
+The ablation checkpoints lie in ``bench/checkpoints/rl/`` (trained by the commands in
+docs/learning.md). The default detector here is the simulator's privileged segmentation (the
+paper's is also privileged: Aerial Gym's segmentation camera).
+
+Run: ``.venv/bin/python bench/rl_reproduction.py [--only rl-table1 ...] [--episodes N]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+from seminspect.learning.agent import load_controller, shipped_policy_path
+from seminspect.learning.baselines import Controller, OrbitController, RandomController
+from seminspect.learning.evaluation import EvaluationResult, evaluate
+from seminspect.learning.rooms import TABLE1_OBSTACLES
+from seminspect.report.markdown import rewrite_sections
+from seminspect.report.rl_tables import (
+    ABLATION_OBSTACLES,
+    NEEDS,
+    SECTIONS,
+    load_evaluations,
+    reproduction_sections,
+)
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT / "docs" / "data" / "rl"
+CHECKPOINTS = ROOT / "bench" / "checkpoints" / "rl"
+DOC = ROOT / "docs" / "reproduction.md"
+SEED, EPISODES, ENVS = 0, 100, 50
+
+#: Evaluation file -> (controller factory, obstacle counts, policy label).
+EVALUATIONS: dict[str, tuple[Callable[[], Controller], tuple[int, ...], str]] = {
+    "table1-learned": (lambda: load_controller(None), TABLE1_OBSTACLES, "learned (shipped)"),
+    "table1-orbit": (OrbitController, TABLE1_OBSTACLES, "orbit"),
+    "table1-random": (lambda: RandomController(SEED), TABLE1_OBSTACLES, "random"),
+    "ablation-no-svs": (
+        lambda: load_controller(CHECKPOINTS / "no-svs.pt"),
+        (ABLATION_OBSTACLES,),
+        "no SVS map",
+    ),
+    "ablation-no-gru": (
+        lambda: load_controller(CHECKPOINTS / "no-gru.pt"),
+        (ABLATION_OBSTACLES,),
+        "no GRU",
+    ),
+}
+
+
+def log(text: str) -> None:
+    print(f"[{time.strftime('%H:%M:%S')}] {text}", flush=True)
+
+
+def run_evaluation(name: str, episodes: int, data: Path) -> EvaluationResult:
+    """Evaluate one controller and keep its JSON under ``data``."""
+    factory, counts, label = EVALUATIONS[name]
+    result = evaluate(factory(), counts, episodes, SEED, num_envs=ENVS, policy=label)
+    result.to_json(data / f"{name}.json")
+    log(f"{name}: {result.wall_seconds:.0f} s")
+    return result
+
+
+def regenerate(
+    wanted: set[str], episodes: int = EPISODES, names: list[str] | None = None
+) -> dict[str, str]:
+    """Run the evaluations the wanted sections need (or ``names``), then build the sections.
+
+    Returns no sections when an evaluation a section needs has never been run.
+    """
+    DATA.mkdir(parents=True, exist_ok=True)
+    for name in names or sorted({n for s in wanted for n in NEEDS[s]}):
+        log(f"evaluating {name} ({episodes} episodes per obstacle count)")
+        run_evaluation(name, episodes, DATA)
+    results = load_evaluations(DATA)
+    missing = sorted({n for s in wanted for n in NEEDS[s]} - set(results))
+    if missing:
+        log(f"not rewriting the tables: no evaluation yet for {', '.join(missing)}")
+        return {}
+    return reproduction_sections(results, wanted)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--only", action="append", choices=SECTIONS, help="(repeatable)")
+    parser.add_argument("--episodes", type=int, default=EPISODES, help="per obstacle count")
+    parser.add_argument(
+        "--evaluation",
+        action="append",
+        choices=sorted(EVALUATIONS),
+        help="run only these evaluations (repeatable; e.g. to spread them over processes)",
+    )
+    parser.add_argument("--tables-only", action="store_true", help="rewrite from stored JSON")
+    parser.add_argument("--doc", type=Path, default=DOC)
+    args = parser.parse_args()
+    wanted = set(args.only or SECTIONS)
+    names = [] if args.tables_only else args.evaluation
+    sections = regenerate(wanted, args.episodes, names)
+    if sections:
+        rewrite_sections(args.doc, sections)
+        log(f"rewrote {', '.join(sorted(sections))} in {args.doc}; policy: {shipped_policy_path()}")
+
+
+if __name__ == "__main__":
+    main()
