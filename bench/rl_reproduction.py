@@ -10,6 +10,9 @@ as JSON in ``docs/data/rl/``; the tables of docs/reproduction.md are made from t
 * ``rl-table2``: the policy trained without the SVS map beside the shipped one, 9 obstacles;
 * ``rl-table3``: the policy trained without a GRU beside the shipped one (GRU 128), 9 obstacles.
 
+With Table I it also draws ``docs/images/rl-coverage.png``: coverage against time of the three
+controllers at each obstacle count (mean and 5th-95th percentile, as 004 Fig 5).
+
 The ablation checkpoints lie in ``bench/checkpoints/rl/`` (trained by the commands in
 docs/learning.md). The default detector here is the simulator's privileged segmentation (the
 paper's is also privileged: Aerial Gym's segmentation camera).
@@ -28,7 +31,9 @@ from seminspect.learning.agent import load_controller, shipped_policy_path
 from seminspect.learning.baselines import Controller, OrbitController, RandomController
 from seminspect.learning.evaluation import EvaluationResult, evaluate
 from seminspect.learning.rooms import TABLE1_OBSTACLES
+from seminspect.report.figures import save_figure
 from seminspect.report.markdown import rewrite_sections
+from seminspect.report.rl import coverage_figure
 from seminspect.report.rl_tables import (
     ABLATION_OBSTACLES,
     NEEDS,
@@ -41,6 +46,7 @@ ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "docs" / "data" / "rl"
 CHECKPOINTS = ROOT / "bench" / "checkpoints" / "rl"
 DOC = ROOT / "docs" / "reproduction.md"
+PICTURE = ROOT / "docs" / "images" / "rl-coverage.png"
 SEED, EPISODES, ENVS = 0, 100, 50
 
 #: Evaluation file -> (controller factory, obstacle counts, policy label).
@@ -90,6 +96,10 @@ def regenerate(
     if missing:
         log(f"not rewriting the tables: no evaluation yet for {', '.join(missing)}")
         return {}
+    if "rl-table1" in wanted:
+        curves = {results[n].policy: results[n] for n in NEEDS["rl-table1"]}
+        save_figure(coverage_figure(curves), PICTURE)
+        log(f"drew {PICTURE}")
     return reproduction_sections(results, wanted)
 
 
