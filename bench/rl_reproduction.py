@@ -11,7 +11,8 @@ as JSON in ``docs/data/rl/``; the tables of docs/reproduction.md are made from t
 * ``rl-table3``: the policy trained without a GRU beside the shipped one (GRU 128), 9 obstacles.
 
 With Table I it also draws ``docs/images/rl-coverage.png``: coverage against time of the three
-controllers at each obstacle count (mean and 5th-95th percentile, as 004 Fig 5).
+controllers at each obstacle count (mean and 5th-95th percentile, as 004 Fig 5), and
+``docs/images/rl-training.png`` from the training logs kept in ``docs/data/rl/``.
 
 The ablation checkpoints lie in ``bench/checkpoints/rl/`` (trained by the commands in
 docs/learning.md). The default detector here is the simulator's privileged segmentation (the
@@ -33,7 +34,7 @@ from seminspect.learning.evaluation import EvaluationResult, evaluate
 from seminspect.learning.rooms import TABLE1_OBSTACLES
 from seminspect.report.figures import save_figure
 from seminspect.report.markdown import rewrite_sections
-from seminspect.report.rl import coverage_figure
+from seminspect.report.rl import coverage_figure, training_figure
 from seminspect.report.rl_tables import (
     ABLATION_OBSTACLES,
     NEEDS,
@@ -47,6 +48,13 @@ DATA = ROOT / "docs" / "data" / "rl"
 CHECKPOINTS = ROOT / "bench" / "checkpoints" / "rl"
 DOC = ROOT / "docs" / "reproduction.md"
 PICTURE = ROOT / "docs" / "images" / "rl-coverage.png"
+TRAINING_PICTURE = ROOT / "docs" / "images" / "rl-training.png"
+#: The training logs kept beside the evaluations (copies of each run's progress.csv).
+TRAINING_LOGS = {
+    "main (shipped)": DATA / "training-main.csv",
+    "no SVS map": DATA / "training-no-svs.csv",
+    "no GRU": DATA / "training-no-gru.csv",
+}
 SEED, EPISODES, ENVS = 0, 100, 50
 
 #: Evaluation file -> (controller factory, obstacle counts, policy label).
@@ -99,7 +107,8 @@ def regenerate(
     if "rl-table1" in wanted:
         curves = {results[n].policy: results[n] for n in NEEDS["rl-table1"]}
         save_figure(coverage_figure(curves), PICTURE)
-        log(f"drew {PICTURE}")
+        save_figure(training_figure(TRAINING_LOGS), TRAINING_PICTURE)
+        log(f"drew {PICTURE} and {TRAINING_PICTURE}")
     return reproduction_sections(results, wanted)
 
 

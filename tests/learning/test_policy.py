@@ -188,8 +188,10 @@ def test_importing_the_package_does_not_load_torch() -> None:
 
 
 def test_small_preset_pools_its_inputs_before_convolving() -> None:
+    from seminspect.learning.policy import _BlockMax3d
+
     small = make_policy(PolicyConfig.small())
-    assert isinstance(small.map_encoder.input_pool, torch.nn.MaxPool3d)
+    assert isinstance(small.map_encoder.input_pool, _BlockMax3d)
     assert isinstance(small.depth_encoder.input_pool, torch.nn.AvgPool2d)
     # A single occupied cell survives the max-pool of the maps: the encoder's output moves.
     empty = torch.zeros(1, *MAPS_SHAPE)
@@ -199,3 +201,16 @@ def test_small_preset_pools_its_inputs_before_convolving() -> None:
         assert not torch.equal(small.map_encoder(empty), small.map_encoder(one))
     paper = make_policy(PolicyConfig.paper())
     assert isinstance(paper.map_encoder.input_pool, torch.nn.Identity)
+
+
+@pytest.mark.parametrize("shape", [(2, 2, 21, 21, 21), (1, 1, 22, 20, 23)])
+def test_block_max_is_max_pool_with_its_gradient(shape) -> None:
+    from seminspect.learning.policy import _BlockMax3d
+
+    x = torch.rand(*shape, generator=torch.Generator().manual_seed(1), requires_grad=True)
+    reference = torch.nn.MaxPool3d(3)(x)
+    ours = _BlockMax3d(3)(x)
+    assert torch.equal(ours, reference)
+    (grad_ours,) = torch.autograd.grad(ours.sum(), x)
+    (grad_reference,) = torch.autograd.grad(reference.sum(), x)
+    assert torch.equal(grad_ours, grad_reference)

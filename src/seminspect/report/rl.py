@@ -214,3 +214,43 @@ def write_episode_pictures(
             episode_coverage_figure(trace, control_hz, title), root / f"{prefix}_coverage.png"
         ),
     ]
+
+
+def training_figure(progress: Mapping[str, str | os.PathLike[str]], window: int = 10) -> Figure:
+    """Coverage and crashes of the episodes ending during training, per run's ``progress.csv``.
+
+    Each point pools the episodes of ``window`` consecutive updates (weighted by their count);
+    the dotted lines mark where the curriculum adds obstacles.
+    """
+    figure = new_figure(10.0, 3.6)
+    cover_ax, crash_ax = figure.add_subplot(1, 2, 1), figure.add_subplot(1, 2, 2)
+    for name, path in progress.items():
+        table = np.genfromtxt(path, delimiter=",", names=True)
+        steps, episodes = table["steps"], table["episodes"]
+        for ax, column in ((cover_ax, "coverage_pct"), (crash_ax, "crash_pct")):
+            x, y = _pooled(steps, episodes, np.nan_to_num(table[column]), window)
+            ax.plot(x / 1e3, y, label=name)
+    first = np.genfromtxt(next(iter(progress.values())), delimiter=",", names=True)
+    changes = np.flatnonzero(np.diff(first["obstacles"]) != 0)
+    for ax, label in ((cover_ax, "coverage [%]"), (crash_ax, "crashed episodes [%]")):
+        for index in changes:
+            ax.axvline(first["steps"][index + 1] / 1e3, color="0.6", linestyle=":")
+        ax.set_xlabel("environment steps [thousands]")
+        ax.set_ylabel(label)
+        ax.set_ylim(0, 100)
+        ax.grid(alpha=0.3)
+    cover_ax.legend(fontsize=8, loc="lower right")
+    figure.tight_layout()
+    return figure
+
+
+def _pooled(
+    steps: NDArray, episodes: NDArray, values: NDArray, window: int
+) -> tuple[NDArray, NDArray]:
+    """Episode-weighted means of ``values`` over consecutive blocks of ``window`` updates."""
+    blocks = np.arange(len(steps)) // window
+    count = np.bincount(blocks, weights=episodes)
+    total = np.bincount(blocks, weights=episodes * values)
+    last = np.bincount(blocks, weights=steps) / np.bincount(blocks)
+    keep = count > 0
+    return last[keep], total[keep] / count[keep]
