@@ -163,3 +163,24 @@ def test_stepping_after_every_room_ended_changes_nothing():
     obs, reward, crash, timeout, _ = env.step(np.ones((2, 4), dtype=np.float32))
     assert np.array_equal(env.positions(), before)
     assert not reward.any() and not crash.any() and not timeout.any()
+
+
+def test_rooms_that_run_on_alone_see_their_own_maps():
+    """When earlier rooms have ended, the later ones must keep sampling their own maps.
+
+    Two copies of the same batch: in one, room 0 ends at once (a 0.1 s episode would end all,
+    so it is frozen by hand); room 1's observations must match the copy where both run.
+    """
+    config = EnvConfig(obstacles=4)
+    both = InspectionVectorEnv(3, config, autoreset=False)
+    alone = InspectionVectorEnv(3, config, autoreset=False)
+    both.reset(seed=8)
+    alone.reset(seed=8)
+    alone._done[0] = True  # room 0 has ended: only rooms 1 and 2 are stepped
+    actions = np.tile(np.array([[0.3, 0.2, 0.0, 0.4]], dtype=np.float32), (3, 1))
+    for _ in range(5):
+        obs_both, reward_both, *_ = both.step(actions)
+        obs_alone, reward_alone, *_ = alone.step(actions)
+    for key in ("state", "depth", "maps"):
+        assert np.array_equal(obs_both[key][1:], obs_alone[key][1:]), key
+    assert np.array_equal(reward_both[1:], reward_alone[1:])
