@@ -96,7 +96,7 @@ def regenerate(
     Returns no sections when an evaluation a section needs has never been run.
     """
     DATA.mkdir(parents=True, exist_ok=True)
-    for name in names or sorted({n for s in wanted for n in NEEDS[s]}):
+    for name in sorted({n for s in wanted for n in NEEDS[s]}) if names is None else names:
         log(f"evaluating {name} ({episodes} episodes per obstacle count)")
         run_evaluation(name, episodes, DATA)
     results = load_evaluations(DATA)

@@ -160,7 +160,7 @@ def test_stepping_after_every_room_ended_changes_nothing():
     for _ in range(2):
         env.step(np.zeros((2, 4), dtype=np.float32))
     before = env.positions()
-    obs, reward, crash, timeout, _ = env.step(np.ones((2, 4), dtype=np.float32))
+    _, reward, crash, timeout, _ = env.step(np.ones((2, 4), dtype=np.float32))
     assert np.array_equal(env.positions(), before)
     assert not reward.any() and not crash.any() and not timeout.any()
 

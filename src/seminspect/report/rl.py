@@ -21,7 +21,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.colors import to_rgba
 from matplotlib.figure import Figure
-from matplotlib.patches import Circle, Polygon, Rectangle, Wedge
+from matplotlib.patches import Circle, Patch, Polygon, Rectangle, Wedge
 from numpy.typing import NDArray
 from scipy.spatial import ConvexHull
 
@@ -55,6 +55,7 @@ def _draw_obstacles(ax: Axes, room: Room) -> None:
     solids = room.solids
     for k in range(1, len(solids.kind)):
         kind, centre = int(solids.kind[k]), solids.centre[k]
+        shape: Patch
         if kind in {BOX, CYLINDER}:
             shape = Polygon(solid_outline(kind, centre, solids.rotation[k], solids.size[k]))
         else:
