@@ -87,3 +87,12 @@ def test_train_refuses_bad_settings_in_one_line(capsys, tmp_path, args, message)
     assert code == 1
     assert message in err and "Traceback" not in err
     assert not (tmp_path / "x" / "checkpoint.pt").exists()
+
+
+def test_without_torch_the_learned_policy_says_how_to_get_it(capsys, tmp_path, monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "torch", None)  # import torch raises ImportError
+    code, _, err = run(capsys, "rl", "eval", "--out", str(tmp_path / "x"))
+    assert code == 1
+    assert "pip install 'seminspect[rl]'" in err and "Traceback" not in err

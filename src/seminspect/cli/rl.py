@@ -57,9 +57,22 @@ def controller_for(policy: str | None, seed: int):
         raise InvalidInputError(
             f"unknown policy {policy!r}: use {', '.join(BASELINES)} or a checkpoint file"
         )
+    _require_torch()
     from seminspect.learning.agent import load_controller
 
     return load_controller(None if policy is None else Path(policy))
+
+
+def _require_torch() -> None:
+    """The learned policy runs on torch, an optional extra: say how to get it."""
+    from seminspect.core.errors import InvalidInputError
+
+    try:
+        import torch  # noqa: F401 - only checking that it is there
+    except ImportError:
+        raise InvalidInputError(
+            "the learned policy needs torch, which is not installed: pip install 'seminspect[rl]'"
+        ) from None
 
 
 def _policy_name(policy: str | None) -> str:
@@ -200,6 +213,7 @@ def train_command(
 
     if steps < 1:
         raise InvalidInputError(f"--steps must be at least 1, got {steps}")
+    _require_torch()
     _check_device(device)
     network = policy_config(config, variant)  # type: ignore[arg-type]
     settings = train_config(steps, seed=seed, num_envs=envs)
