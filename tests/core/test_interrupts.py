@@ -23,3 +23,21 @@ def test_a_signal_during_a_deferred_block_arrives_after_it() -> None:
         finished.append("last status written")
     assert finished == ["last status written"] and caught.value.signum == signal.SIGTERM
     assert "SIGTERM" in caught.value.describe()
+
+
+def test_a_signal_while_numba_compiles_is_raised_once_compilation_ends():
+    import time
+
+    from numba.core.compiler_lock import global_compiler_lock
+
+    reached = []
+    with stop_on_signals(), pytest.raises(Interrupted) as stopped:
+        with global_compiler_lock:
+            os.kill(os.getpid(), signal.SIGTERM)
+            for _ in range(20):  # the handler runs here and must not raise
+                time.sleep(0.01)
+            reached.append("end of compilation")
+        for _ in range(300):  # delivered again shortly after
+            time.sleep(0.01)
+    assert reached == ["end of compilation"]
+    assert stopped.value.signum == signal.SIGTERM

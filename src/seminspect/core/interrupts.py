@@ -4,13 +4,17 @@ SIGTERM is what ``timeout``, systemd, ``docker stop`` and CI cancellation send. 
 is to die on the spot, leaving whatever was being written claiming to be in progress; inside
 :func:`stop_on_signals` both signals raise :class:`Interrupted` instead, so ``finally`` blocks
 record why the work stopped. :func:`deferred_signals` holds them back for a few lines that must
-not be cut in half (the last status of a run directory).
+not be cut in half (the last status of a run directory). A signal that arrives while numba
+compiles a kernel is delivered again once it has finished: raising inside numba's callbacks
+into Python would be swallowed and crash the process.
 """
 
 from __future__ import annotations
 
 import contextlib
+import os
 import signal
+import sys
 import threading
 from collections.abc import Iterator
 from types import FrameType
@@ -54,7 +58,28 @@ class _Handler:
         if self.deferring:
             self.pending = self.pending or signum
             return
+        if _numba_compiling():
+            # The handler may be running inside numba's ctypes callbacks, where an exception
+            # is swallowed and leaves LLVM half-done (a crash follows): ask again shortly.
+            _redeliver(signum)
+            return
         raise Interrupted(signum)
+
+
+#: How long a stop signal waits before it is delivered again while numba compiles (s).
+REDELIVERY_DELAY = 0.05
+
+
+def _numba_compiling() -> bool:
+    """Whether numba is compiling now (checked without importing numba)."""
+    lock_module = sys.modules.get("numba.core.compiler_lock")
+    return lock_module is not None and lock_module.global_compiler_lock.is_locked()
+
+
+def _redeliver(signum: int) -> None:
+    timer = threading.Timer(REDELIVERY_DELAY, os.kill, (os.getpid(), signum))
+    timer.daemon = True
+    timer.start()
 
 
 class _Installed:
