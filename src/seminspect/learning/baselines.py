@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from seminspect.core.rng import make_rng
-from seminspect.learning.env import ACTION_SIZE, InspectionVectorEnv
+from seminspect.learning.env import ACTION_SIZE, InspectionVectorEnv, body_from_world
 
 
 class Controller(Protocol):
@@ -84,18 +84,7 @@ class OrbitController:
         command = np.zeros((env.num_envs, 3))
         command[:, :2] = self.gain * (radius - distance)[:, None] * outward + 0.6 * tangent
         command[:, 2] = self.gain * (height - position[:, 2])
-        c, s = np.cos(yaw), np.sin(yaw)
-        body = (
-            np.stack(
-                [
-                    c * command[:, 0] + s * command[:, 1],
-                    -s * command[:, 0] + c * command[:, 1],
-                    command[:, 2],
-                ],
-                axis=1,
-            )
-            / cfg.max_speed
-        )
+        body = body_from_world(command, yaw) / cfg.max_speed
         facing = np.angle(np.exp(1j * (angle + math.pi - yaw)))
         yaw_rate = 2.0 * facing / cfg.max_yaw_rate
         return np.clip(np.column_stack([body, yaw_rate]), -1.0, 1.0).astype(np.float32)

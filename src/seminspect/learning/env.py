@@ -333,6 +333,20 @@ def spatial_visit_scores(counts: NDArray) -> tuple[NDArray[np.float32], NDArray[
     return scores, totals
 
 
+def world_from_body(vectors: NDArray, yaw: NDArray) -> NDArray[np.float64]:
+    """Rows of body-frame vectors in the world frame of a level vehicle with heading ``yaw``."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    x, y = vectors[:, 0], vectors[:, 1]
+    return np.stack([c * x - s * y, s * x + c * y, vectors[:, 2]], 1)
+
+
+def body_from_world(vectors: NDArray, yaw: NDArray) -> NDArray[np.float64]:
+    """Rows of world-frame vectors in the body frame of a level vehicle with heading ``yaw``."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    x, y = vectors[:, 0], vectors[:, 1]
+    return np.stack([c * x + s * y, -s * x + c * y, vectors[:, 2]], 1)
+
+
 def face_scores(
     distance: NDArray[np.float64],
     best: NDArray[np.float64],
@@ -586,11 +600,7 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         dt, tau = 1.0 / cfg.control_hz, cfg.velocity_time_constant
         decay = math.exp(-dt / tau)
         a = action[envs].astype(np.float64)
-        c, s = np.cos(self._yaw[envs]), np.sin(self._yaw[envs])
-        body = a[:, :3] * cfg.max_speed
-        command = np.stack(
-            [c * body[:, 0] - s * body[:, 1], s * body[:, 0] + c * body[:, 1], body[:, 2]], 1
-        )
+        command = world_from_body(a[:, :3] * cfg.max_speed, self._yaw[envs])
         push = np.stack([self._rngs[e].normal(0.0, cfg.disturbance_std, 3) for e in envs])
         command += push * tau
         v = self._velocity[envs]
@@ -619,14 +629,15 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         assert self._caster is not None and self._solids is not None
         cfg = self.config
         target = self._solids.centre[envs, 0], self._solids.size[envs, 0]
-        origin = self._position[envs] + np.outer(envs * self._spacing, (1.0, 0.0, 0.0))
+        shift = np.outer(envs * self._spacing, (1.0, 0.0, 0.0))  # rooms' places in the scene
+        origin = self._position[envs] + shift
         row, ray, starts, dirs = _sensor_rays(
             origin,
             self._yaw[envs],
             self._camera,
             self._lidar,
             self._mapped,
-            target[0] + np.outer(envs * self._spacing, (1.0, 0.0, 0.0)),
+            target[0] + shift,
             target[1],
             cfg.camera_range,
         )
@@ -639,7 +650,7 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
             starts,
             dirs,
             noisy,
-            origin - self._position[envs],
+            shift,
             row,
             cfg.map_resolution,
         )
@@ -733,9 +744,7 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         half = np.asarray(cfg.room_size) / 2.0
         noise = np.stack([self._rngs[e].uniform(-1.0, 1.0, 8) for e in envs]) * cfg.state_noise
         yaw = self._yaw[envs] + noise[:, 3]
-        c, s = np.cos(self._yaw[envs]), np.sin(self._yaw[envs])
-        v = self._velocity[envs]
-        body_v = np.stack([c * v[:, 0] + s * v[:, 1], -s * v[:, 0] + c * v[:, 1], v[:, 2]], 1)
+        body_v = body_from_world(self._velocity[envs], self._yaw[envs])
         state = self._obs["state"]
         state[envs, 0:3] = (self._position[envs] + noise[:, :3] - half) / half
         state[envs, 3] = np.cos(yaw / 2)
