@@ -34,4 +34,6 @@ def test_bad_rays_and_meshes_are_refused() -> None:
     with pytest.raises(InvalidInputError):
         caster.cast((0, 0, 0), np.zeros((3, 2)))
     with pytest.raises(InvalidInputError):
+        caster.cast((0, 0, 0), np.zeros((3, 3), dtype=np.float32), np.ones(2))
+    with pytest.raises(InvalidInputError):
         RayCaster(np.zeros((3, 3)), np.zeros((0, 3), dtype=int))

@@ -1,9 +1,11 @@
 """First-hit ray casting against a world mesh with Embree.
 
-Embree (through ``embreex``) traces rays in single precision. The scene is shifted so that the
-world's centre sits at the origin, which keeps metre-scale worlds far inside float32's precision.
-Asking Embree for the hit distance ``tfar`` costs nothing extra, so the caster returns distances
-directly instead of intersecting rays with triangle planes afterwards.
+Embree traces rays in single precision. The scene is shifted so that the world's centre sits at
+the origin, which keeps metre-scale worlds far inside float32's precision. Asking Embree for the
+hit distance ``tfar`` costs nothing extra, so the caster returns distances directly instead of
+intersecting rays with triangle planes afterwards. Rays go through a compiled loop over Embree's
+C API (``worlds.embree``) that writes only the distance and face of each ray; ``embreex``'s own
+loop is the fallback where its library cannot be loaded, with the same hits.
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ from __future__ import annotations
 import itertools
 from concurrent.futures import ThreadPoolExecutor
 from functools import cache
+from typing import NamedTuple
 
 import numpy as np
 from embreex import rtcore_scene
@@ -18,6 +21,7 @@ from embreex.mesh_construction import TriangleMesh
 from numpy.typing import ArrayLike, NDArray
 
 from seminspect.core.errors import InvalidInputError
+from seminspect.worlds.embree import EmbreeScene, cast_rays, embree_library
 
 #: Embree's "no hit" primitive id.
 NO_HIT = -1
@@ -42,12 +46,14 @@ class RayCaster:
             raise InvalidInputError("ray caster needs at least one triangle")
         self.offset = 0.5 * (verts.min(axis=0) + verts.max(axis=0))
         self.face_count = len(tris)
-        self._scene = rtcore_scene.EmbreeScene()
-        TriangleMesh(
-            scene=self._scene,
-            vertices=(verts - self.offset).astype(np.float32),
-            indices=tris.astype(np.int32),
-        )
+        shifted = (verts - self.offset).astype(np.float32)
+        library = embree_library()
+        if library is not None:
+            self._compiled: EmbreeScene | None = EmbreeScene(library, shifted, tris)
+        else:
+            self._compiled = None
+            self._scene = rtcore_scene.EmbreeScene()
+            TriangleMesh(scene=self._scene, vertices=shifted, indices=tris.astype(np.int32))
 
     def cast(
         self,
@@ -70,41 +76,67 @@ class RayCaster:
             ``(distance, face)``: ``float32`` distances (``inf`` for no hit within range) and
             ``int32`` face indices (``-1`` for no hit).
         """
-        dirs = np.ascontiguousarray(directions, dtype=np.float32)
+        dirs = np.asarray(directions, dtype=np.float32)
         if dirs.ndim != 2 or dirs.shape[1] != 3:
             raise InvalidInputError(f"ray directions must have shape (N, 3), got {dirs.shape}")
         count = dirs.shape[0]
         start = np.asarray(origins, dtype=np.float64) - self.offset
-        if start.shape == (3,):
-            # Embree reads through strides, so one shared origin needs no copy per ray.
-            start32 = np.broadcast_to(start.astype(np.float32), (count, 3))
-        elif start.shape == (count, 3):
-            start32 = start.astype(np.float32)
-        else:
+        if start.shape not in ((3,), (count, 3)):
             raise InvalidInputError(f"ray origins must be (3,) or ({count}, 3), got {start.shape}")
-        limit = np.broadcast_to(np.asarray(max_range, dtype=np.float32), (count,))
-        limit = np.ascontiguousarray(np.minimum(limit, np.float32(1e30)))
-        face, distance = self._run(start32, dirs, limit, threads)
-        distance[face == NO_HIT] = np.inf
-        return distance, face
+        starts = start.astype(np.float32).reshape(-1, 3)
+        limit = np.minimum(np.asarray(max_range, dtype=np.float32), np.float32(1e30)).reshape(-1)
+        if limit.shape[0] not in (1, count):
+            raise InvalidInputError(f"max_range must be one value or {count}, got {limit.shape}")
+        batch = _Batch(starts, dirs, limit, np.empty(count, np.float32), np.empty(count, np.int32))
+        parts = _parts(count, threads)
+        cast_part = self._cast_compiled if self._compiled is not None else self._cast_embreex
+        if len(parts) == 1:
+            cast_part(batch, parts[0])
+        else:
+            list(_pool(threads).map(lambda part: cast_part(batch, part), parts))
+        return batch.distance, batch.face
 
-    def _run(
-        self, starts: NDArray, dirs: NDArray, limit: NDArray, threads: int
-    ) -> tuple[NDArray[np.int32], NDArray[np.float32]]:
-        if threads <= 1 or len(dirs) < 2 * MIN_RAYS_PER_THREAD:
-            hits = self._scene.run(starts, dirs, dists=limit, output=1)
-            return hits["primID"], hits["tfar"]
-        bounds = np.linspace(0, len(dirs), threads + 1).astype(int)
-        parts = [slice(a, b) for a, b in itertools.pairwise(bounds)]
-        hits = list(
-            _pool(threads).map(
-                lambda part: self._scene.run(starts[part], dirs[part], dists=limit[part], output=1),
-                parts,
-            )
+    def _cast_compiled(self, batch: _Batch, part: slice) -> None:
+        scene = self._compiled
+        assert scene is not None
+        cast_rays(
+            scene.intersect,
+            scene.scene,
+            batch.starts if len(batch.starts) == 1 else batch.starts[part],
+            np.ascontiguousarray(batch.directions[part]),
+            batch.limits if len(batch.limits) == 1 else batch.limits[part],
+            batch.distance[part],
+            batch.face[part],
         )
-        face = np.concatenate([h["primID"] for h in hits])
-        distance = np.concatenate([h["tfar"] for h in hits])
-        return face, distance
+
+    def _cast_embreex(self, batch: _Batch, part: slice) -> None:
+        count = len(batch.directions)
+        hits = self._scene.run(
+            np.broadcast_to(batch.starts, (count, 3))[part],
+            np.ascontiguousarray(batch.directions[part]),
+            dists=np.ascontiguousarray(np.broadcast_to(batch.limits, (count,))[part]),
+            output=1,
+        )
+        batch.face[part] = hits["primID"]
+        batch.distance[part] = np.where(hits["primID"] == NO_HIT, np.inf, hits["tfar"])
+
+
+class _Batch(NamedTuple):
+    """One call's rays (origins shifted, ``float32``) and the outputs its parts fill."""
+
+    starts: NDArray[np.float32]  # (N, 3), or (1, 3) shared
+    directions: NDArray[np.float32]  # (N, 3)
+    limits: NDArray[np.float32]  # (N,), or (1,) shared
+    distance: NDArray[np.float32]
+    face: NDArray[np.int32]
+
+
+def _parts(count: int, threads: int) -> list[slice]:
+    """Contiguous ray ranges, one per thread; one range below the split's break-even."""
+    if threads <= 1 or count < 2 * MIN_RAYS_PER_THREAD:
+        return [slice(0, count)]
+    bounds = np.linspace(0, count, threads + 1).astype(int)
+    return [slice(int(a), int(b)) for a, b in itertools.pairwise(bounds)]
 
 
 @cache
