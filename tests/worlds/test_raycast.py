@@ -27,6 +27,19 @@ def test_max_range_per_ray_and_a_shared_origin() -> None:
     np.testing.assert_allclose(distance[1:], 4.0, atol=1e-5)
 
 
+def test_hits_written_into_given_buffers() -> None:
+    caster = box_world().raycaster
+    directions = np.array([[1, 0, 0], [0, 0, -1], [0, 0, 1]], dtype=np.float32)
+    distance, face = np.full(3, np.nan, np.float32), np.full(3, 7, np.int32)
+    written = caster.cast((0.0, 0.0, 1.0), directions, out=(distance, face))
+    assert written[0] is distance and written[1] is face
+    expected = caster.cast((0.0, 0.0, 1.0), directions)
+    np.testing.assert_array_equal(distance, expected[0])
+    np.testing.assert_array_equal(face, expected[1])
+    with pytest.raises(InvalidInputError, match="contiguous"):
+        caster.cast((0.0, 0.0, 1.0), directions, out=(distance.astype(np.float64), face))
+
+
 def test_bad_rays_and_meshes_are_refused() -> None:
     caster = box_world().raycaster
     with pytest.raises(InvalidInputError):

@@ -13,6 +13,7 @@ field of view and d_max = 30 m (the experimental camera has 86 deg).
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 
@@ -96,6 +97,11 @@ class CameraModel:
         ).reshape(-1, 3)
         body /= np.linalg.norm(body, axis=1, keepdims=True)
         return body.astype(np.float32), np.ascontiguousarray(body[:, 0], dtype=np.float32)
+
+    @cached_property
+    def ray_limits(self) -> NDArray[np.float32]:
+        """Length of each ray (row-major) at which its depth reaches ``max_range``."""
+        return self.max_range / self.rays[1]
 
 
 @dataclass(eq=False)
@@ -189,10 +195,13 @@ def render(
     quat = as_quaternion(orientation, "camera orientation")
     model = camera.scaled(stride)
     directions_body, cosine = model.rays
+    count = len(cosine)
+    directions, distance = _scratch(count)
     rotation = Rotation.from_quat(quat).as_matrix().astype(np.float32)
-    directions = rotate_rows(directions_body, rotation)
-    distance, face = world.raycaster.cast(origin, directions, model.max_range / cosine)
-    count = len(face)
+    rotate_rows(directions_body, rotation, out=directions)
+    distance, face = world.raycaster.cast(
+        origin, directions, model.ray_limits, out=(distance, np.empty(count, dtype=np.int32))
+    )
     depth = np.empty(count, dtype=np.float32)
     instance = np.empty(count, dtype=np.int32)
     class_id = np.empty(count, dtype=np.int16)
@@ -243,6 +252,24 @@ def render(
     if noise is not None and not noise.is_ideal:
         _add_image_noise(frame, noise, require_rng(rng))
     return frame
+
+
+_SCRATCH = threading.local()
+
+
+def _scratch(count: int) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+    """This thread's ray directions ``(count, 3)`` and distances, reused from frame to frame.
+
+    Neither leaves :func:`render` (a frame keeps its own arrays), so one pair per thread and
+    ray count saves allocating and faulting in 5 MB per 640 x 480 frame.
+    """
+    if not hasattr(_SCRATCH, "by_count"):
+        _SCRATCH.by_count = {}
+    buffers = _SCRATCH.by_count.get(count)
+    if buffers is None:
+        buffers = (np.empty((count, 3), np.float32), np.empty(count, np.float32))
+        _SCRATCH.by_count[count] = buffers
+    return buffers
 
 
 def _add_image_noise(frame: Frame, noise: NoiseModel, rng: np.random.Generator) -> None:

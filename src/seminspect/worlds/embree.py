@@ -40,6 +40,8 @@ _FORMAT_FLOAT3 = 0x9003
 _SCENE_FLAG_ROBUST = 1 << 2
 _INVALID_ID = 0xFFFFFFFF
 
+#: Farthest distance handed to Embree: larger limits (``inf``) are clamped to it.
+MAX_TFAR = np.float32(1e30)
 #: 32-bit words of one ``RTCRayHit`` (48-byte ray, 32-byte hit), and the word offsets used.
 RAYHIT_WORDS = 20
 _TFAR, _MASK, _PRIM_ID, _GEOM_ID = 8, 9, 17, 18
@@ -174,8 +176,8 @@ def cast_rays(  # noqa: PLR0917 - a compiled kernel takes its arrays positionall
     """First hits of rays ``[0, len(directions))`` into ``distance`` and ``face``.
 
     ``origins`` is ``(N, 3)`` or one ``(1, 3)`` row shared by every ray, ``limits`` ``(N,)``
-    or one shared value; all ``float32``, origins in the scene's (shifted) frame. Misses get
-    ``inf`` and ``-1``.
+    or one shared value (clamped to :data:`MAX_TFAR`); all ``float32``, origins in the scene's
+    (shifted) frame. Misses get ``inf`` and ``-1``.
     """
     # Embree wants the ray 16-byte aligned; twice its size leaves slack for a wider RTCHit.
     block = np.zeros(2 * RAYHIT_WORDS + 4, dtype=np.uint32)
@@ -194,7 +196,7 @@ def cast_rays(  # noqa: PLR0917 - a compiled kernel takes its arrays positionall
         rayhit[5] = directions[i, 1]
         rayhit[6] = directions[i, 2]
         rayhit[7] = 0.0  # time
-        rayhit[_TFAR] = limits[0] if shared_limit else limits[i]
+        rayhit[_TFAR] = min(limits[0] if shared_limit else limits[i], MAX_TFAR)
         words[_MASK] = _INVALID_ID  # every mask bit
         words[10] = 0  # id
         words[11] = 0  # flags

@@ -21,7 +21,7 @@ from embreex.mesh_construction import TriangleMesh
 from numpy.typing import ArrayLike, NDArray
 
 from seminspect.core.errors import InvalidInputError
-from seminspect.worlds.embree import EmbreeScene, cast_rays, embree_library
+from seminspect.worlds.embree import MAX_TFAR, EmbreeScene, cast_rays, embree_library
 
 #: Embree's "no hit" primitive id.
 NO_HIT = -1
@@ -61,6 +61,8 @@ class RayCaster:
         directions: ArrayLike,
         max_range: float | ArrayLike = np.inf,
         threads: int = 1,
+        *,
+        out: tuple[NDArray[np.float32], NDArray[np.int32]] | None = None,
     ) -> tuple[NDArray[np.float32], NDArray[np.int32]]:
         """Distance to and index of the first triangle hit by each ray.
 
@@ -71,6 +73,8 @@ class RayCaster:
             max_range: ignore hits farther than this, one value or one per ray.
             threads: split the rays over this many threads (Embree releases the GIL, so
                 large batches scale with cores; results do not depend on the split).
+            out: ``(distance, face)`` arrays of ``N`` ``float32`` and ``int32`` to write into,
+                e.g. buffers reused between frames (returned).
 
         Returns:
             ``(distance, face)``: ``float32`` distances (``inf`` for no hit within range) and
@@ -84,10 +88,11 @@ class RayCaster:
         if start.shape not in ((3,), (count, 3)):
             raise InvalidInputError(f"ray origins must be (3,) or ({count}, 3), got {start.shape}")
         starts = start.astype(np.float32).reshape(-1, 3)
-        limit = np.minimum(np.asarray(max_range, dtype=np.float32), np.float32(1e30)).reshape(-1)
+        limit = np.ascontiguousarray(max_range, dtype=np.float32).reshape(-1)
         if limit.shape[0] not in (1, count):
             raise InvalidInputError(f"max_range must be one value or {count}, got {limit.shape}")
-        batch = _Batch(starts, dirs, limit, np.empty(count, np.float32), np.empty(count, np.int32))
+        distance, face = _outputs(count, out)
+        batch = _Batch(starts, dirs, limit, distance, face)
         parts = _parts(count, threads)
         cast_part = self._cast_compiled if self._compiled is not None else self._cast_embreex
         if len(parts) == 1:
@@ -114,7 +119,7 @@ class RayCaster:
         hits = self._scene.run(
             np.broadcast_to(batch.starts, (count, 3))[part],
             np.ascontiguousarray(batch.directions[part]),
-            dists=np.ascontiguousarray(np.broadcast_to(batch.limits, (count,))[part]),
+            dists=np.minimum(np.broadcast_to(batch.limits, (count,))[part], MAX_TFAR),
             output=1,
         )
         batch.face[part] = hits["primID"]
@@ -129,6 +134,18 @@ class _Batch(NamedTuple):
     limits: NDArray[np.float32]  # (N,), or (1,) shared
     distance: NDArray[np.float32]
     face: NDArray[np.int32]
+
+
+def _outputs(
+    count: int, out: tuple[NDArray, NDArray] | None
+) -> tuple[NDArray[np.float32], NDArray[np.int32]]:
+    if out is None:
+        return np.empty(count, np.float32), np.empty(count, np.int32)
+    distance, face = out
+    for array, dtype in ((distance, np.float32), (face, np.int32)):
+        if array.shape != (count,) or array.dtype != dtype or not array.flags.c_contiguous:
+            raise InvalidInputError(f"cast outputs must be contiguous ({count},) {dtype.__name__}")
+    return distance, face
 
 
 def _parts(count: int, threads: int) -> list[slice]:
