@@ -8,7 +8,7 @@ from seminspect.core.errors import InvalidInputError
 from seminspect.core.params import preset
 from seminspect.core.rng import make_rng
 from seminspect.geometry.transforms import quat_from_yaw
-from seminspect.sensors import CameraModel, noise_preset, render
+from seminspect.sensors import CameraModel, NoiseModel, noise_preset, render
 from seminspect.sensors.noise import make_noise
 from sim_worlds import box_world, car_world
 
@@ -141,12 +141,15 @@ def test_strided_render_and_odometry_tagging(wall) -> None:
 def _reference_image_noise(frame, noise, rng) -> None:
     """The image noise as two numpy draws: the oracle the compiled single pass must equal."""
     hit = np.isfinite(frame.depth)
+    dtype = np.float32 if noise.image_noise_float32 else np.float64
     if noise.depth_noise_m or noise.depth_noise_per_m:
         sigma = noise.depth_noise_m + noise.depth_noise_per_m * frame.depth[hit]
-        noisy = frame.depth[hit] + rng.standard_normal(sigma.shape).astype(np.float32) * sigma
+        deviates = rng.standard_normal(sigma.shape, dtype=dtype).astype(np.float32)
+        noisy = frame.depth[hit] + deviates * sigma
         frame.depth[hit] = np.maximum(noisy, np.float32(1e-3))
     if noise.intensity_noise:
-        jitter = rng.normal(0.0, noise.intensity_noise, frame.intensity.shape)
+        deviates = rng.standard_normal(frame.intensity.shape, dtype=dtype).astype(np.float64)
+        jitter = noise.intensity_noise * deviates
         frame.intensity[:] = np.clip(frame.intensity + jitter, 0, 255).astype(np.uint8)
 
 
@@ -156,6 +159,7 @@ def _reference_image_noise(frame, noise, rng) -> None:
         noise_preset("realistic"),
         make_noise({"depth_noise_per_m": 0.05}),
         make_noise({"intensity_noise": 40.0}),
+        make_noise({"image_noise_float32": True}, base="realistic"),
     ],
 )
 def test_image_noise_in_one_pass_equals_the_two_draws(noise) -> None:
@@ -166,3 +170,17 @@ def test_image_noise_in_one_pass_equals_the_two_draws(noise) -> None:
     noisy = render(car_world(), SMALL, *pose, noise=noise, rng=make_rng(7, "camera"))
     np.testing.assert_array_equal(noisy.depth, expected.depth)
     np.testing.assert_array_equal(noisy.intensity, expected.intensity)
+
+
+def test_float32_image_noise_is_an_option_with_other_numbers() -> None:
+    pose = ((-8.0, 1.0, 1.5), quat_from_yaw(-0.1))
+    default = noise_preset("realistic")
+    single = make_noise({"image_noise_float32": True}, base="realistic")
+    frames = [
+        render(car_world(), SMALL, *pose, noise=model, rng=make_rng(7, "camera"))
+        for model in (default, single)
+    ]
+    assert not default.image_noise_float32  # published runs keep the float64 draw
+    assert not np.array_equal(frames[0].depth, frames[1].depth)
+    assert np.array_equal(np.isfinite(frames[0].depth), np.isfinite(frames[1].depth))
+    assert NoiseModel(image_noise_float32=True).is_ideal  # no noise to draw in either dtype

@@ -12,7 +12,8 @@ def test_presets() -> None:
     changed = {
         name for name in NoiseModel.model_fields if getattr(ideal, name) != getattr(realistic, name)
     }
-    assert changed == set(NoiseModel.model_fields)  # realistic sets every fault
+    # realistic sets every fault; the precision of the image noise draw is not one
+    assert changed == set(NoiseModel.model_fields) - {"image_noise_float32"}
     with pytest.raises(UnknownNameError, match="realistic"):
         noise_preset("realstic")
 

@@ -255,6 +255,8 @@ def render(
 
 
 _SCRATCH = threading.local()
+#: The dtype of the image noise draw, by ``NoiseModel.image_noise_float32``.
+_DRAW_DTYPE = {False: np.float64, True: np.float32}
 
 
 def _scratch(count: int) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
@@ -277,6 +279,8 @@ def _add_image_noise(frame: Frame, noise: NoiseModel, rng: np.random.Generator) 
 
     All the normal deviates come from one draw: the hit pixels' depth noise first (row-major),
     then one per intensity pixel, the same numbers in the same order as two separate draws.
+    ``noise.image_noise_float32`` draws them in single precision (about half the time of the
+    draw, and different numbers).
     """
     depth = frame.depth.reshape(-1)  # views: render's images are contiguous
     noisy_depth = bool(noise.depth_noise_m or noise.depth_noise_per_m)
@@ -285,7 +289,7 @@ def _add_image_noise(frame: Frame, noise: NoiseModel, rng: np.random.Generator) 
     _apply_image_noise(
         depth,
         frame.intensity.reshape(-1),
-        rng.standard_normal(hits + pixels),
+        rng.standard_normal(hits + pixels, dtype=_DRAW_DTYPE[noise.image_noise_float32]),
         hits > 0,
         np.float32(noise.depth_noise_m),
         np.float32(noise.depth_noise_per_m),
