@@ -67,7 +67,15 @@ def shade_hits(  # noqa: PLR0917 - a compiled kernel takes its arrays positional
     part_id: np.ndarray,
     intensity: np.ndarray,
 ) -> None:
-    """Fill the per-pixel outputs (flat arrays) from ray distances and face indices."""
+    """Fill the per-pixel outputs (flat arrays) from ray distances and face indices.
+
+    Neighbouring pixels mostly see the same texture cell, so each octave keeps its last cell
+    and value and hashes only when the cell changes (the same values, fewer hashes).
+    """
+    last_ix = np.zeros(octaves.shape[0], dtype=np.int64)
+    last_iy = np.zeros(octaves.shape[0], dtype=np.int64)
+    last_seed = np.full(octaves.shape[0], -1, dtype=np.int64)  # seeds are >= 0: no match
+    last_value = np.zeros(octaves.shape[0])
     for i in range(distance.shape[0]):
         f = face[i]
         if f < 0:
@@ -95,7 +103,11 @@ def shade_hits(  # noqa: PLR0917 - a compiled kernel takes its arrays positional
             else:
                 ix = int(np.floor(u / cell))
                 iy = int(np.floor(v / cell))
-                texture += weights[k] * _hash(ix, iy, plane_seed[f] + k)
+                seed = plane_seed[f] + k
+                if ix != last_ix[k] or iy != last_iy[k] or seed != last_seed[k]:
+                    last_ix[k], last_iy[k], last_seed[k] = ix, iy, seed
+                    last_value[k] = _hash(ix, iy, seed)
+                texture += weights[k] * last_value[k]
         cosine = abs(light[f])
         value = 255.0 * albedo[f] * (0.35 + 0.65 * cosine) * (0.45 + 0.55 * texture)
         intensity[i] = np.uint8(min(255.0, value))
