@@ -1,8 +1,8 @@
 """Embree's C API called from compiled code, on the library that ``embreex`` ships.
 
-``embreex`` traces one ray per call of ``rtcIntersect1`` inside a compiled loop, but it hands
-back six fresh arrays per batch (barycentrics, normals, ids) and reads its rays through
-Python's buffer protocol, which a frame pays for again on every call. Here the same scene is
+``embreex`` traces one ray per call of ``rtcIntersect1`` inside a compiled loop, but to return
+both the distance and the face of each ray it hands back six fresh arrays per batch
+(barycentrics, normals, ids), which a frame paid for on every call. Here the same scene is
 built through the same C calls (``rtcNewGeometry`` with a copied float3 vertex and uint3 index
 buffer, a robust scene: ``embreex``'s defaults), and a numba kernel calls ``rtcIntersect1`` for
 each ray and writes only the distance and the face, so the hits are the library's own, bit for
