@@ -279,8 +279,8 @@ def _add_image_noise(frame: Frame, noise: NoiseModel, rng: np.random.Generator) 
 
     All the normal deviates come from one draw: the hit pixels' depth noise first (row-major),
     then one per intensity pixel, the same numbers in the same order as two separate draws.
-    ``noise.image_noise_float32`` draws them in single precision (about half the time of the
-    draw, and different numbers).
+    ``noise.image_noise_float32`` draws them in single precision (a faster draw, and other
+    numbers).
     """
     depth = frame.depth.reshape(-1)  # views: render's images are contiguous
     noisy_depth = bool(noise.depth_noise_m or noise.depth_noise_per_m)
