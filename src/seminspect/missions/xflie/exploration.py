@@ -15,9 +15,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from seminspect.missions.config import survey_headings
-from seminspect.missions.navigation import find_frontiers
 from seminspect.missions.xflie.context import MissionContext
 from seminspect.missions.xflie.sightings import register_targets
+from seminspect.planning.frontier import find_frontiers
 
 #: Frontiers nearer than this to the robot (or to one already visited) are not worth a trip [m].
 FRONTIER_MIN_DISTANCE = 3.0
