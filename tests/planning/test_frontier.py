@@ -50,8 +50,9 @@ def test_no_frontier_in_a_fully_known_map() -> None:
 def test_the_gain_is_the_unknown_area_within_the_radius() -> None:
     grid = corridor_map()  # unknown: x >= 10 m (below the wall) and y >= 8.5 m
     far_west, on_boundary = [1.0, 4.0, 0.7], [10.0, 4.0, 0.7]
-    gains = unknown_area(grid, BAND, np.array([far_west, on_boundary]), radius=3.0)
-    assert gains[0] == 0.0
+    off_map = [-15.0, 4.0, 0.7]  # its window, wrapped around, would reach the unknown half
+    gains = unknown_area(grid, BAND, np.array([far_west, on_boundary, off_map]), radius=3.0)
+    assert gains[0] == 0.0 and gains[2] == 0.0
     # About half of a 3 m disk lies east of the boundary.
     assert gains[1] == pytest.approx(0.5 * np.pi * 3.0**2, rel=0.15)
 

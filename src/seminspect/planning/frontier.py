@@ -89,11 +89,12 @@ def unknown_area(
     # Pad so that every window is whole: cells outside the map count as known (nothing to gain).
     padded = np.pad(unknown, reach, constant_values=False)
     centres = np.floor((np.asarray(goals, dtype=np.float64)[:, :2] - occupancy.origin[:2]) / res)
+    on_map = np.all((centres >= 0) & (centres < occupancy.shape[:2]), axis=1)
     gains = np.zeros(len(centres))
-    for k, (i, j) in enumerate(centres.astype(np.int64)):
+    for k in np.flatnonzero(on_map):  # a goal off the map gains nothing
+        i, j = centres[k].astype(np.int64)
         window = padded[i : i + 2 * reach + 1, j : j + 2 * reach + 1]
-        if window.shape == disk.shape:  # a goal off the map sees none of it
-            gains[k] = np.count_nonzero(window & disk) * res**2
+        gains[k] = np.count_nonzero(window & disk) * res**2
     return gains
 
 
