@@ -9,7 +9,9 @@ document; the prose and the paper's own rows around them are left as written. Se
 * ``table5``, ``targets``: 000 Table 5 on the city seed-0 runs of the same missions (queries
   answered by both planners, the volumetric one over the ground band and the full volume);
 * ``scaling``: the synthetic-city scaling study (000 Fig 13 analogue);
-* ``table6``: 000 Table 6, each city scenario with both planners over seeds 0-2;
+* ``table6``: 000 Table 6, each city scenario with xFLIE, the volumetric baseline and the
+  frontier explorer over seeds 0-2 (``--table6-planner`` runs some of them and keeps the
+  document's rows of the others);
 * ``rl-table1``, ``rl-table2``, ``rl-table3``: 004 Tables I-III from ``bench/rl_reproduction.py``
   (the shipped policy, its ablations and the baselines, 100 episodes per obstacle count).
 
@@ -30,11 +32,17 @@ from mission_acceptance import CITY, HEADER, OTHERS, acceptance_lines, row, run_
 from planning_targets import targets_markdown, targets_met
 from rl_reproduction import SECTIONS as RL_SECTIONS
 from rl_reproduction import regenerate as rl_regenerate
-from seminspect.report.markdown import rewrite_sections
+from seminspect.report.markdown import rewrite_sections, section_body
 from seminspect.studies.planning.scaling import SCALING_SIZES, scaling_study
-from seminspect.studies.planning.study import PlanningStudy, compare_run, mission_study
+from seminspect.studies.planning.study import (
+    TABLE6_PLANNERS,
+    PlanningStudy,
+    compare_run,
+    mission_study,
+)
 from seminspect.studies.planning.tables import (
     both_volumes_beside_paper,
+    merge_table6_rows,
     scaling_markdown,
     study_document,
     table6_summary,
@@ -97,10 +105,17 @@ def _name(run: dict) -> str:
 
 
 def planning_sections(
-    runs_dir: Path, seed0_runs: list[Path], wanted: set[str], table6_scenarios: list[str]
+    runs_dir: Path,
+    seed0_runs: list[Path],
+    wanted: set[str],
+    *,
+    table6_scenarios: list[str],
+    table6_planners: list[str],
+    doc: Path,
 ) -> dict[str, str]:
     """Table 5 (both volumes) on the city seed-0 runs, the scaling study and Table 6 (over
-    ``table6_scenarios``)."""
+    ``table6_scenarios`` and ``table6_planners``; rows of other planners are kept from
+    ``doc``)."""
     sections: dict[str, str] = {}
     ground, full = [], []
     if wanted & {"table5", "targets"}:
@@ -120,8 +135,11 @@ def planning_sections(
     if "scaling" in wanted:
         sections["scaling"] = scaling_markdown(scaling).split("\n", 2)[2]
     if "table6" in wanted:
-        outcomes = mission_study(table6_scenarios, runs_dir / "planning", progress=_table6_log)
-        sections["table6"] = table6_summary(outcomes)
+        outcomes = mission_study(
+            table6_scenarios, runs_dir / "planning", _table6_log, planners=table6_planners
+        )
+        current = section_body(doc.read_text(encoding="utf-8"), "table6")
+        sections["table6"] = merge_table6_rows(current, table6_summary(outcomes))
     return sections
 
 
@@ -151,12 +169,26 @@ def main() -> None:
         choices=SCENARIOS,
         help="city scenario of Table 6 (repeatable; default: all three)",
     )
+    parser.add_argument(
+        "--table6-planner",
+        action="append",
+        choices=TABLE6_PLANNERS,
+        help="planner of Table 6 (repeatable; default: all three); the document's rows of the "
+        "others are kept",
+    )
     args = parser.parse_args()
     wanted = set(args.only or SECTIONS)
     if args.fresh and args.runs.exists():
         shutil.rmtree(args.runs)
     sections, seed0 = table3_sections(args.runs, wanted)
-    sections |= planning_sections(args.runs, seed0, wanted, args.table6_scenario or list(SCENARIOS))
+    sections |= planning_sections(
+        args.runs,
+        seed0,
+        wanted,
+        table6_scenarios=args.table6_scenario or list(SCENARIOS),
+        table6_planners=args.table6_planner or list(TABLE6_PLANNERS),
+        doc=args.doc,
+    )
     if wanted & set(RL_SECTIONS):
         sections |= rl_regenerate(wanted & set(RL_SECTIONS))
     rewrite_sections(args.doc, sections)

@@ -18,12 +18,24 @@ def test_mission_runs_and_says_where_the_results_are(capsys, tmp_path: Path) -> 
     assert "plotly" in (out / "report.html").read_text(encoding="utf-8")
 
 
+@pytest.mark.slow
+def test_the_frontier_explorer_runs_from_the_command_line(capsys, tmp_path: Path) -> None:
+    out = tmp_path / "explorer"
+    code, text, _ = run(
+        capsys, "mission", "--world", "city", "--scenario", "small", "--planner", "frontier",
+        "--budget", "60", "--no-pictures", "--out", str(out),
+    )  # fmt: skip
+    assert code == 0 and "completed" in text and "inspected 0%" in text
+    assert '"planner": "frontier"' in (out / "config.json").read_text(encoding="utf-8")
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [
         (("mission", "--world", "atlantis"), "unknown world 'atlantis'"),
         (("mission", "--preset", "urban"), "preset"),
         (("mission", "--seed", "-3"), "--seed"),
+        (("mission", "--planner", "gbplanner"), "--planner"),
     ],
 )
 def test_bad_mission_settings_exit_non_zero_with_one_line(capsys, tmp_path, args, message) -> None:

@@ -4,7 +4,12 @@ import numpy as np
 import pytest
 
 from seminspect.graphs.lsg.model import TargetNode, TargetStatus
-from seminspect.missions.evaluation import TruthTarget, score_targets
+from seminspect.missions.evaluation import (
+    TruthTarget,
+    localisation_rmse,
+    score_targets,
+    scored_matches,
+)
 
 
 def node(name: str, label: str, x: float, y: float, inspected: bool = True) -> TargetNode:
@@ -48,3 +53,17 @@ def test_class_and_gate_block_matches() -> None:
     assert score.matches == () and score.detected_pct == 0.0
     assert math.isnan(score.rmse())
     assert score_targets([], TRUTH).truths == 3
+
+
+def test_an_explorer_is_scored_on_every_target_it_found() -> None:
+    targets = [
+        node("car-0", "car", 0.3, 0.4, inspected=False),  # 0.5 m from car-a
+        node("car-1", "car", 10.0, 1.2, inspected=False),  # 1.2 m from car-b
+        node("truck-2", "truck", 0.0, 21.0),  # 1.0 m from truck-c, inspected
+    ]
+    score = score_targets(targets, TRUTH)
+    found = scored_matches(score.matches, inspecting=False)
+    assert {m.target_id for m in found} == {"car-0", "car-1", "truck-2"}
+    assert [m.target_id for m in scored_matches(score.matches, inspecting=True)] == ["truck-2"]
+    assert localisation_rmse(found) == pytest.approx(math.sqrt((0.5**2 + 1.2**2 + 1.0**2) / 3))
+    assert math.isnan(localisation_rmse([]))

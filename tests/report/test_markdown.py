@@ -1,7 +1,12 @@
 import pytest
 
 from seminspect.core.errors import FileFormatError
-from seminspect.report.markdown import replace_sections, rewrite_sections, section_names
+from seminspect.report.markdown import (
+    replace_sections,
+    rewrite_sections,
+    section_body,
+    section_names,
+)
 
 DOC = """# Results
 
@@ -57,3 +62,10 @@ def test_an_unknown_section_is_refused_and_the_file_kept(tmp_path) -> None:
     assert "\nnew\n<!-- END table:t6 -->" in doc.read_text(encoding="utf-8")
     with pytest.raises(FileFormatError, match="cannot read"):
         rewrite_sections(tmp_path / "missing.md", {"t6": "x"})
+
+
+def test_a_sections_body_is_read_back_without_its_markers() -> None:
+    assert section_body(DOC, "t3") == "| a | b |\n|---|---|\n| 1 | 2 |\n"
+    assert section_body(DOC, "t6") == "old\n"
+    with pytest.raises(FileFormatError, match="no section named t5"):
+        section_body(DOC, "t5")

@@ -64,7 +64,8 @@ def planning(
 
     Times both planners on synthetic cities of growing size.
 
-    Compares whole missions with either planner. Writes planning.md, planning.json, scaling.png.
+    Compares whole missions with either planner and with the frontier explorer (Table 6's third
+    row). Writes planning.md, planning.json, scaling.png.
     """
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 

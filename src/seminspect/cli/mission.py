@@ -24,6 +24,7 @@ class NoiseChoice(str, Enum):
 class PlannerChoice(str, Enum):
     hierarchical = "hierarchical"
     volumetric = "volumetric"
+    frontier = "frontier"
 
 
 def app(
@@ -54,7 +55,8 @@ def app(
     planner: PlannerChoice = typer.Option(
         PlannerChoice.hierarchical,
         "--planner",
-        help="hierarchical (3DLSG, the default) or volumetric (the paper's baseline).",
+        help="hierarchical (3DLSG, the default), volumetric (the paper's baseline) or frontier "
+        "(pure exploration that never inspects: 000 Table 6's exploration baseline).",
     ),
     budget: float | None = typer.Option(
         None, "--budget", help="Time budget in simulated seconds (default: 000 Sec VII-D's).", min=1

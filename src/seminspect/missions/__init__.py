@@ -1,6 +1,7 @@
-"""Missions: the xFLIE explore-inspect-explore executive and its run directory."""
+"""Missions: the xFLIE explore-inspect-explore executive, the frontier explorer, run directories."""
 
 from seminspect.missions.config import MissionConfig, ResolvedMissionConfig, make_config, resolve
+from seminspect.missions.frontier_mission import FrontierMission
 from seminspect.missions.metrics import MissionMetrics
 from seminspect.missions.platform import Platform, SimulatedPlatform
 from seminspect.missions.recorder import MissionRecorder
@@ -10,6 +11,7 @@ from seminspect.missions.terrain_mapping import map_world
 from seminspect.missions.xflie import XFlie
 
 __all__ = [
+    "FrontierMission",
     "MissionConfig",
     "MissionMetrics",
     "MissionRecorder",

@@ -17,7 +17,9 @@ from seminspect.core.vocabulary import BUILDING_FEATURES, VEHICLE_PARTS
 
 Mode = Literal["ground", "aerial"]
 NoiseName = Literal["ideal", "realistic"]
-PlannerName = Literal["hierarchical", "volumetric"]
+#: hierarchical: xFLIE; volumetric: 000 Sec VII-D's baseline between targets; frontier: pure
+#: exploration that never inspects (Table 6's exploration baseline, GBPlanner2.0's role).
+PlannerName = Literal["hierarchical", "volumetric", "frontier"]
 
 VEHICLE_CLASSES = ("car", "truck")
 
@@ -181,6 +183,11 @@ def resolve(config: MissionConfig) -> ResolvedMissionConfig:
             "inspection": inspection,
         }
     )
+
+
+def inspects(planner: str) -> bool:
+    """Whether missions with this planner inspect targets (the frontier explorer does not)."""
+    return planner != "frontier"
 
 
 def survey_headings(fov_deg: float, overlap: float) -> int:

@@ -8,6 +8,7 @@ horizontal distance (the Hungarian method), ignoring pairs farther apart than a 
   reports inspection as a share of detections);
 * **localisation RMSE**: root mean square distance between inspected targets and their true
   centres, horizontal (what the containment-polygon refinement corrects) and 3D (000 Table 6);
+  a mission that never inspects is scored on every target it found (:func:`scored_matches`);
 * **false targets**: target nodes matched to no true object.
 """
 
@@ -69,10 +70,20 @@ class TargetScore:
 
     def rmse(self, horizontal: bool = True) -> float:
         """RMSE over inspected, matched targets (NaN when none)."""
-        errors = [
-            m.horizontal_error if horizontal else m.error_3d for m in self.matches if m.inspected
-        ]
-        return math.sqrt(float(np.mean(np.square(errors)))) if errors else math.nan
+        return localisation_rmse([m for m in self.matches if m.inspected], horizontal)
+
+
+def localisation_rmse(matches: Sequence[Match], horizontal: bool = True) -> float:
+    """Root mean square localisation error of ``matches`` [m] (NaN when there are none)."""
+    errors = [m.horizontal_error if horizontal else m.error_3d for m in matches]
+    return math.sqrt(float(np.mean(np.square(errors)))) if errors else math.nan
+
+
+def scored_matches(matches: Sequence[Match], inspecting: bool) -> list[Match]:
+    """The targets 000 Table 6's coverage and RMSE are taken over: the inspected ones, or for
+    a mission that never inspects (an explorer) every target it found; the paper scores
+    GBPlanner2.0 on the targets it observed (000 Sec VII-D)."""
+    return [m for m in matches if m.inspected or not inspecting]
 
 
 def score_targets(

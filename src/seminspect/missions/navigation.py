@@ -1,4 +1,4 @@
-"""Driving the robot: routes on its own map, sensing on the way, and exploration frontiers.
+"""Driving the robot: routes on its own map, and sensing on the way.
 
 :class:`Navigator` follows a route in steps, scanning with the LiDAR every ``lidar_every_m``
 metres and handing a camera frame to the mission every ``camera_every_m`` (so targets are found
@@ -21,14 +21,13 @@ from typing import Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import ndimage
 
 from seminspect.core.errors import PlanningError
-from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap
+from seminspect.mapping.voxel import OCCUPIED, VoxelMap
 from seminspect.missions.metrics import Timers
 from seminspect.missions.platform import Platform
 from seminspect.planning.grid_search import GridPath
-from seminspect.planning.gridmap import CostGrid, planar_states
+from seminspect.planning.gridmap import CostGrid
 from seminspect.planning.local import LocalPlanner
 from seminspect.sensors import Frame, LidarScan
 
@@ -237,47 +236,3 @@ class Navigator:
         if self.planner.mode == "ground":
             return horizontal <= radius + ARRIVAL_SLACK
         return float(np.linalg.norm(goal - here)) <= radius + ARRIVAL_SLACK
-
-
-@dataclass(frozen=True)
-class Frontier:
-    """A boundary between known free and unknown space, at the robot's height."""
-
-    goal: NDArray[np.float64]
-    cells: int
-
-
-def find_frontiers(
-    occupancy: VoxelMap,
-    band: tuple[float, float],
-    min_cells: int,
-    height: float,
-    wall_clearance: float = 1.0,
-) -> list[Frontier]:
-    """Frontiers of the map's height band: free cells touching unknown ones, grouped.
-
-    Free cells closer than ``wall_clearance`` to an obstacle are left out: along a wall the
-    unknown side is the inside of a building, which no visit can reveal. Each group's goal is
-    its cell closest to the group's mean, lifted to ``height``.
-    """
-    layer = planar_states(occupancy, band)[:, :, 0]
-    free = layer == FREE
-    touching = ndimage.binary_dilation(
-        layer == UNKNOWN, structure=ndimage.generate_binary_structure(2, 1)
-    )
-    open_space = ndimage.distance_transform_edt(layer != OCCUPIED) * occupancy.resolution
-    frontier = free & touching & (open_space > wall_clearance)
-    labels, count = ndimage.label(frontier, structure=np.ones((3, 3), dtype=bool))
-    if count == 0:
-        return []
-    sizes = np.bincount(labels.ravel())
-    found = []
-    for group in np.flatnonzero(sizes >= min_cells):
-        if group == 0:
-            continue
-        cells = np.argwhere(labels == group)
-        centre = cells.mean(axis=0)
-        pick = cells[np.argmin(((cells - centre) ** 2).sum(axis=1))]
-        xy = occupancy.origin[:2] + (pick + 0.5) * occupancy.resolution
-        found.append(Frontier(np.array([xy[0], xy[1], height]), int(sizes[group])))
-    return found

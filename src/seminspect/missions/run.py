@@ -21,13 +21,16 @@ import numpy as np
 from seminspect.core.errors import SeminspectError
 from seminspect.core.interrupts import stop_on_signals
 from seminspect.mapping.voxel import VoxelMap
-from seminspect.missions.config import MissionConfig, ResolvedMissionConfig, resolve
+from seminspect.missions.config import MissionConfig, ResolvedMissionConfig, inspects, resolve
 from seminspect.missions.evaluation import (
     DEFAULT_GATE_M,
     TargetScore,
     TruthTarget,
+    localisation_rmse,
     score_targets,
+    scored_matches,
 )
+from seminspect.missions.frontier_mission import FrontierMission
 from seminspect.missions.metrics import (
     CpuMeter,
     GraphFigures,
@@ -94,7 +97,8 @@ def build_mission(
     )
     ground_z = float(platform.position[2] - start_height)
     occupancy = VoxelMap.covering(world, config.map_resolution)
-    mission = XFlie(config, platform, occupancy, ground_z=ground_z, run=run, progress=progress)
+    executive = XFlie if inspects(config.planner) else FrontierMission
+    mission = executive(config, platform, occupancy, ground_z=ground_z, run=run, progress=progress)
     return mission, world
 
 
@@ -247,14 +251,14 @@ def graph_figures(mission: XFlie, score: TargetScore, planning: list[float]) -> 
 def quality_figures(
     mission: XFlie, world: World, cpu: CpuMeter, score: TargetScore
 ) -> QualityFigures:
-    """000 Table 6's columns: load, localisation error, and coverage over inspected targets
-    (surface coverage and the paper's bounding-box volume)."""
+    """000 Table 6's columns: load, localisation error, and coverage over the scored targets
+    (surface coverage and the paper's bounding-box volume): those inspected, or every target
+    found by a mission that only explores."""
     by_name = {info.name: info for info in world.instances.values()}
     coverage = mission.recorder.coverage
+    scored = scored_matches(score.matches, inspects(mission.config.planner))
     surface, box, truth_box = [], 0.0, 0.0
-    for match in score.matches:
-        if not match.inspected:
-            continue
+    for match in scored:
         info = by_name[match.truth]
         surface.append(coverage.surface_coverage(match.target_id, world, info.id))
         box += coverage.targets[match.target_id].box_volume
@@ -262,8 +266,8 @@ def quality_figures(
     return QualityFigures(
         cpu.load_pct(),
         planning_load_pct(mission),
-        _finite(score.rmse(horizontal=True)),
-        _finite(score.rmse(horizontal=False)),
+        _finite(localisation_rmse(scored, horizontal=True)),
+        _finite(localisation_rmse(scored, horizontal=False)),
         100.0 * float(np.mean(surface)) if surface else None,
         box,
         truth_box,

@@ -1,5 +1,7 @@
-"""Planning: target utility (eq 6), hierarchical and semantic planning, view planning, baselines."""
+"""Planning: target utility (eq 6), hierarchical and semantic planning, view planning, baselines,
+frontier exploration."""
 
+from seminspect.planning.frontier import FrontierPlanner
 from seminspect.planning.grid_search import GridPath
 from seminspect.planning.gridmap import CostGrid, CostModel
 from seminspect.planning.hierarchical import HierarchicalPlanner, RoutePlan
@@ -14,6 +16,7 @@ from seminspect.planning.volumetric import RebuildingVolumetricPlanner, Volumetr
 __all__ = [
     "CostGrid",
     "CostModel",
+    "FrontierPlanner",
     "GridPath",
     "HierarchicalPlanner",
     "LocalPlanner",

@@ -47,18 +47,31 @@ def replace_sections(text: str, sections: Mapping[str, str]) -> str:
     if unknown:
         raise FileFormatError(f"no section named {', '.join(unknown)} in the document")
     for name, body in sections.items():
-        key = re.escape(name)
-        pattern = re.compile(
-            rf"(^<!-- BEGIN table:{key} -->\n).*?(^<!-- END table:{key} -->$)",
-            re.MULTILINE | re.DOTALL,
-        )
-        text = pattern.sub(_verbatim(body.strip("\n") + "\n"), text, count=1)
+        text = _section(name).sub(_verbatim(body.strip("\n") + "\n"), text, count=1)
     return text
+
+
+def section_body(text: str, name: str) -> str:
+    """The body of section ``name`` of ``text``, without its markers."""
+    if name not in section_names(text):
+        raise FileFormatError(f"no section named {name} in the document")
+    match = _section(name).search(text)
+    assert match is not None  # section_names found both markers
+    return match.group(2)
+
+
+def _section(name: str) -> re.Pattern[str]:
+    """A section's BEGIN line, body and END line as groups 1-3."""
+    key = re.escape(name)
+    return re.compile(
+        rf"(^<!-- BEGIN table:{key} -->\n)(.*?)(^<!-- END table:{key} -->$)",
+        re.MULTILINE | re.DOTALL,
+    )
 
 
 def _verbatim(lines: str) -> Callable[[re.Match[str]], str]:
     """A replacement function: the body is written as given, backslashes and all."""
-    return lambda match: match.group(1) + lines + match.group(2)
+    return lambda match: match.group(1) + lines + match.group(3)
 
 
 def rewrite_sections(path: str | os.PathLike[str], sections: Mapping[str, str]) -> Path:

@@ -194,3 +194,18 @@ def test_queries_keep_to_targets_the_graph_joins_to_the_start() -> None:
     queries = select_queries(graph, start, 4, reachable={"car-0"})
     assert queries and all(q.endswith("of car-0") for q in queries)
     assert any(q.endswith("of car-1") for q in select_queries(graph, start, 4))
+
+
+@pytest.mark.slow
+def test_the_frontier_explorer_is_read_as_scored_on_the_targets_it_found(tmp_path: Path) -> None:
+    config = study_config("small", "frontier", table6=True).model_copy(
+        update={"time_budget_s": 100.0}
+    )
+    run_dir = ensure_run(config, tmp_path)
+    outcome = MissionOutcome.read(run_dir, "small", "frontier")
+    assert run_dir.name == "city-small-seed0-frontier-charged"
+    assert outcome.inspected == 0 and outcome.found >= 1
+    assert len(outcome.inspected_errors) == outcome.found  # every found target is scored
+    assert outcome.rmse_m == pytest.approx(
+        math.sqrt(np.mean(np.square(list(outcome.inspected_errors.values()))))
+    )

@@ -1,5 +1,6 @@
 """The planning study's tables, figure and JSON."""
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -11,6 +12,7 @@ from seminspect.studies.planning.study import MissionOutcome
 from seminspect.studies.planning.tables import (
     both_volumes_beside_paper,
     common_target_rmse,
+    merge_table6_rows,
     study_markdown,
     table6_summary,
     write_study,
@@ -76,3 +78,33 @@ def test_the_condensed_table_5_puts_both_volumes_beside_the_paper() -> None:
     assert rows["VP/HP time at 0.5 m, searches, full (median / min)"][0] == "75,000 / 50,000"
     assert rows["valid segments: graph edges, HP, refined, VP 0.5 m"][0].startswith("97.6% of 41")
     assert "full volume" not in "\n".join(both_volumes_beside_paper(ground, []))
+
+
+def test_the_frontier_row_stands_beside_gbplanner_and_is_compared_with_xflie() -> None:
+    explorer = dataclasses.replace(
+        _outcome("frontier", 0, {"car-0": 1.5, "car-1": 2.0, "car-4": 0.5}, 0.01),
+        inspected=0,
+        found=4,
+    )
+    outcomes = [_outcome("hierarchical", 0, {"car-0": 0.1, "car-1": 0.3}, 0.02), explorer]
+    # Like for like with xFLIE: car-0 and car-1, which xFLIE inspected and the explorer found.
+    assert common_target_rmse(outcomes, "frontier") == pytest.approx(math.sqrt(6.25 / 2))
+    row = table6_summary(outcomes).splitlines()[3]
+    assert row.startswith("| small | frontier | 0 | 0.010 | 180.0 (87.6) | 100.0 (64.2) |")
+    assert "(0.660)" in row and "| found 4 / 5 |" in row
+
+
+def test_regenerating_one_planner_keeps_the_other_rows_in_order() -> None:
+    hierarchical = _outcome("hierarchical", 0, {"car-0": 0.1}, 0.02)
+    volumetric = _outcome("volumetric", 0, {"car-0": 0.2}, 0.04)
+    explorer = dataclasses.replace(_outcome("frontier", 0, {"car-0": 1.0}, 0.01), found=3)
+    current = table6_summary([hierarchical, volumetric])
+    merged = merge_table6_rows(current, table6_summary([explorer]))
+    lines = merged.splitlines()
+    assert lines[:2] == current.splitlines()[:2]
+    planners = [line.split("|")[2].strip() for line in lines[2:]]
+    assert planners == ["hierarchical", "volumetric", "frontier"]
+    assert lines[2:4] == current.splitlines()[2:4]  # the kept rows, unchanged
+    newer = dataclasses.replace(explorer, found=5)
+    assert "found 5 / 5" in merge_table6_rows(merged, table6_summary([newer]))
+    assert merge_table6_rows(merged, table6_summary([newer])).count("| frontier |") == 1

@@ -10,14 +10,16 @@ remembered and not chosen again.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import NDArray
 
 from seminspect.missions.config import survey_headings
-from seminspect.missions.navigation import find_frontiers
 from seminspect.missions.xflie.context import MissionContext
 from seminspect.missions.xflie.sightings import register_targets
+from seminspect.planning.frontier import find_frontiers
+from seminspect.sensors import Frame
 
 #: Frontiers nearer than this to the robot (or to one already visited) are not worth a trip [m].
 FRONTIER_MIN_DISTANCE = 3.0
@@ -28,10 +30,16 @@ FRONTIER_RADIUS = 1.5
 
 
 class Exploration:
-    """Surveys and frontier hops, with the memory of frontiers already spent."""
+    """Surveys and frontier hops, with the memory of frontiers already spent.
 
-    def __init__(self, ctx: MissionContext) -> None:
+    ``on_frame`` takes each survey frame (default: register its targets, eqs 3-5).
+    """
+
+    def __init__(
+        self, ctx: MissionContext, on_frame: Callable[[Frame], object] | None = None
+    ) -> None:
         self.ctx = ctx
+        self.on_frame = on_frame or (lambda frame: register_targets(ctx, frame))
         #: Goals of frontiers visited or found unreachable.
         self.spent_frontiers: list[NDArray[np.float64]] = []
 
@@ -44,7 +52,7 @@ class Exploration:
             if ctx.time_left <= 0:
                 return
             ctx.platform.turn_to(start + k * 2.0 * math.pi / count)
-            register_targets(ctx, ctx.capture())
+            self.on_frame(ctx.capture())
         ctx.on_step()
 
     def explore(self) -> bool:

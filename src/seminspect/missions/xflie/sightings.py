@@ -15,8 +15,11 @@ from seminspect.perception.detections import detection_points, observe
 from seminspect.sensors import Detection, Frame
 
 
-def register_targets(ctx: MissionContext, frame: Frame) -> None:
-    """Eqs (3)-(5) for one frame: register its detections, optimise, merge."""
+def register_targets(ctx: MissionContext, frame: Frame) -> list[tuple[Detection, str]]:
+    """Eqs (3)-(5) for one frame: register its detections, optimise, merge.
+
+    Returns each detection that became, or merged into, a target node, with that node's id.
+    """
     config, graph = ctx.config, ctx.graph
     with ctx.timers("perception"):
         detections = ctx.detect(frame, "instance", config.target_classes)
@@ -32,6 +35,7 @@ def register_targets(ctx: MissionContext, frame: Frame) -> None:
             for d in detections
         ]
     with ctx.timers("graph"):
+        registered = [d for d, z in zip(detections, observations, strict=True) if z is not None]
         for z in observations:
             if z is not None:
                 graph.register_target(z)
@@ -43,6 +47,8 @@ def register_targets(ctx: MissionContext, frame: Frame) -> None:
             target=added,
             position=graph.target(added).position.round(2).tolist(),
         )
+    # Candidates are resolved in registration order (one per registered detection).
+    return [(d, node) for d, node in zip(registered, update.resolved, strict=True) if node]
 
 
 def target_view(

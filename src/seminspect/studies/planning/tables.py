@@ -21,12 +21,15 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from seminspect.core.io import atomic_write_text, finite_or_none, write_versioned_json
+from seminspect.missions.config import inspects
 from seminspect.report.figures import new_figure, save_figure
 from seminspect.studies.planning.scaling import ScalingPoint
 from seminspect.studies.planning.study import (
+    CITY_SCENARIOS,
     PAPER_TABLE5,
     PAPER_TABLE6,
     RESOLUTIONS,
+    TABLE6_PLANNERS,
     MissionOutcome,
     PaperQuery,
     PlanningStudy,
@@ -301,9 +304,10 @@ def table5_markdown(runs: Sequence[RunComparison]) -> str:
 
 
 def common_target_rmse(outcomes: Sequence[MissionOutcome], planner: str) -> float | None:
-    """Horizontal RMSE of ``planner``'s missions over the targets that both planners inspected in
-    the same scenario and seed, pooled over the runs: the two planners scored on one target set
-    (each mission's own RMSE covers whatever it inspected within its budget)."""
+    """Horizontal RMSE of ``planner``'s missions over the targets that it and its counterpart
+    (:func:`_other_planner`) both scored in the same scenario and seed, pooled over the runs:
+    two planners on one target set (each mission's own RMSE covers whatever it scored within
+    its budget)."""
     runs = {(o.scenario, o.seed, o.planner): o for o in outcomes}
     errors = []
     for (scenario, seed, name), outcome in runs.items():
@@ -316,6 +320,8 @@ def common_target_rmse(outcomes: Sequence[MissionOutcome], planner: str) -> floa
 
 
 def _other_planner(planner: str) -> str:
+    """xFLIE is compared with the volumetric baseline; each baseline (the frontier explorer
+    too) with xFLIE."""
     return "volumetric" if planner == "hierarchical" else "hierarchical"
 
 
@@ -343,7 +349,7 @@ def table6_summary(outcomes: Sequence[MissionOutcome]) -> str:
     for (scenario, planner), runs in groups.items():
         cpu, cover, rmse = PAPER_TABLE6.get(scenario, {}).get(planner, (None, None, None))
         common = common_target_rmse([o for o in outcomes if o.scenario == scenario], planner)
-        inspected = "; ".join(f"{o.inspected} / {o.true_targets}" for o in runs)
+        inspected = "; ".join(f"{_scored_count(o)} / {o.true_targets}" for o in runs)
         lines.append(
             f"| {scenario} | {planner} | {', '.join(str(o.seed) for o in runs)} "
             f"| {_spread((o.planning_load_pct for o in runs), 3)} "
@@ -353,6 +359,42 @@ def table6_summary(outcomes: Sequence[MissionOutcome]) -> str:
             f"| {_num(common, 3)} | {inspected} | {_spread((o.sim_time_s for o in runs), 0)} |"
         )
     return "\n".join(lines) + "\n"
+
+
+def merge_table6_rows(current: str, fresh: str) -> str:
+    """``fresh`` (a :func:`table6_summary`) with the rows of ``current`` (an earlier one) for
+    scenarios and planners it lacks: regenerating one planner's missions keeps the others' rows.
+    Rows are ordered by scenario, then planner as in ``TABLE6_PLANNERS``."""
+    header, rows = _table_rows(fresh)
+    _, kept = _table_rows(current)
+    by_key = {_row_key(row): row for row in kept} | {_row_key(row): row for row in rows}
+
+    def order(key: tuple[str, str]) -> tuple[int, int, str, str]:
+        scenario, planner = key
+        return (_index(CITY_SCENARIOS, scenario), _index(TABLE6_PLANNERS, planner), *key)
+
+    return "\n".join([*header, *(by_key[key] for key in sorted(by_key, key=order))]) + "\n"
+
+
+def _table_rows(table: str) -> tuple[list[str], list[str]]:
+    """A Markdown table's header lines (title and rule) and its rows."""
+    lines = [line for line in table.splitlines() if line.startswith("|")]
+    return lines[:2], lines[2:]
+
+
+def _row_key(row: str) -> tuple[str, str]:
+    """The scenario and planner cells of a Table 6 row."""
+    cells = [cell.strip() for cell in row.strip("|").split("|")]
+    return cells[0], cells[1]
+
+
+def _index(names: Sequence[str], name: str) -> int:
+    return names.index(name) if name in names else len(names)
+
+
+def _scored_count(outcome: MissionOutcome) -> str:
+    """Targets inspected, or for a mission that never inspects those found ("found 4")."""
+    return str(outcome.inspected) if inspects(outcome.planner) else f"found {outcome.found}"
 
 
 def table6_markdown(outcomes: Sequence[MissionOutcome]) -> str:
@@ -374,8 +416,8 @@ def table6_markdown(outcomes: Sequence[MissionOutcome]) -> str:
             f"| {o.scenario} | {o.seed} | {o.planner} | {_num(o.cpu_load_pct, 1)} ({_num(cpu, 1)}) "
             f"| {_num(o.planning_load_pct, 3)} | {_num(o.bbox_volume_m3, 1)} ({_num(cover, 1)}) "
             f"| {_num(o.surface_coverage_pct, 1)} | {_num(o.rmse_m, 3)} ({_num(rmse, 3)}) "
-            f"| {o.inspected} / {o.true_targets} | {o.sim_time_s:.0f} | {o.planning_wall_s:.2f} "
-            f"| {o.route_plans} |"
+            f"| {_scored_count(o)} / {o.true_targets} | {o.sim_time_s:.0f} "
+            f"| {o.planning_wall_s:.2f} | {o.route_plans} |"
         )
     return "\n".join(lines) + "\n"
 
