@@ -256,7 +256,7 @@ def render(
 
 _SCRATCH = threading.local()
 #: The dtype of the image noise draw, by ``NoiseModel.image_noise_float32``.
-_DRAW_DTYPE = {False: np.float64, True: np.float32}
+_DRAW_DTYPE: dict[bool, type[np.float32] | type[np.float64]] = {False: np.float64, True: np.float32}
 
 
 def _scratch(count: int) -> tuple[NDArray[np.float32], NDArray[np.float32]]:

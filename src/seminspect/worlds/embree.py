@@ -99,7 +99,10 @@ class EmbreeScene:
     """
 
     def __init__(self, library: ctypes.CDLL, vertices: NDArray, faces: NDArray) -> None:
-        self.intersect = ctypes.cast(library.rtcIntersect1, ctypes.c_void_p).value
+        address = ctypes.cast(library.rtcIntersect1, ctypes.c_void_p).value
+        if address is None:
+            raise EmbreeError("Embree's rtcIntersect1 has no address")
+        self.intersect: int = address
         device = library.rtcNewDevice(None)
         if not device:
             raise EmbreeError("Embree could not create a device")
@@ -120,7 +123,13 @@ class EmbreeScene:
 
 
 def _fill(
-    library: ctypes.CDLL, geometry: int, rows: NDArray, *, kind: int, dtype: type, stride: int
+    library: ctypes.CDLL,
+    geometry: int,
+    rows: NDArray,
+    *,
+    kind: int,
+    dtype: type[np.generic],
+    stride: int,
 ) -> None:
     """Copy ``(n, 3)`` ``rows`` into a new geometry buffer of ``stride`` items per row."""
     layout = _FORMAT_FLOAT3 if kind == _BUFFER_TYPE_VERTEX else _FORMAT_UINT3
@@ -130,7 +139,7 @@ def _fill(
     if not address:
         raise EmbreeError("Embree could not allocate a geometry buffer")
     items = (ctypes.c_byte * (len(rows) * stride * np.dtype(dtype).itemsize)).from_address(address)
-    view = np.frombuffer(items, dtype=dtype).reshape(len(rows), stride)
+    view = np.frombuffer(memoryview(items), dtype=dtype).reshape(len(rows), stride)
     view[:, :3] = rows
 
 
@@ -203,7 +212,7 @@ def cast_rays(  # noqa: PLR0917 - a compiled kernel takes its arrays positionall
         words[_PRIM_ID] = _INVALID_ID
         words[_GEOM_ID] = _INVALID_ID
         words[19] = _INVALID_ID  # instID[0]
-        _intersect1(function, scene, words)
+        _intersect1(function, scene, words)  # type: ignore[call-arg]  # numba passes typingctx
         if words[_PRIM_ID] == _INVALID_ID:
             distance[i] = np.inf
             face[i] = -1
