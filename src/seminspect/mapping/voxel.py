@@ -49,7 +49,8 @@ class VoxelMap:
     Attributes:
         origin: world coordinates of the grid's minimum corner (metres).
         resolution: edge length of a cell (metres).
-        states: ``uint8`` array of shape ``(nx, ny, nz)`` holding UNKNOWN, FREE or OCCUPIED.
+        states: ``uint8`` array of shape ``(nx, ny, nz)`` holding UNKNOWN, FREE or OCCUPIED,
+            kept C-ordered (a strided view is copied) so the ray walk can step through it flat.
     """
 
     origin: NDArray[np.float64]
@@ -63,6 +64,7 @@ class VoxelMap:
         self.resolution = float(self.resolution)
         if self.states.ndim != 3 or self.states.dtype != np.uint8:
             raise InvalidInputError("voxel states must be a 3D uint8 array")
+        self.states = np.ascontiguousarray(self.states)
 
     @classmethod
     def empty(cls, lower: ArrayLike, upper: ArrayLike, resolution: float) -> VoxelMap:
@@ -188,7 +190,9 @@ class VoxelMap:
         if flags.shape != (len(ends),):
             raise InvalidInputError(f"{flags.size} hit flags for {len(ends)} rays")
         if len(ends):
-            integrate_rays_kernel(self.states, self.origin, self.resolution, start, ends, flags)
+            integrate_rays_kernel(
+                self.states, self.origin, self.resolution, start, ends, flags, np.zeros(0)
+            )
 
     def integrate_frame(self, frame: Frame, stride: int = 4, use_odometry: bool = False) -> None:
         """Integrate every ``stride``-th pixel of a depth frame (rows and columns).
