@@ -28,10 +28,20 @@ def main() -> None:
     parser.add_argument("--world", default="city")
     parser.add_argument("--scenario", default="large")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--carving-spacing", type=float, help="thinned free-space carving (cells; default exact)"
+    )
     parser.add_argument("--profile", action="store_true", help="also print the top functions")
     args = parser.parse_args()
 
-    config = make_config({"world": args.world, "scenario": args.scenario, "seed": args.seed})
+    config = make_config(
+        {
+            "world": args.world,
+            "scenario": args.scenario,
+            "seed": args.seed,
+            "map_carving_spacing": args.carving_spacing,
+        }
+    )
     profiler = cProfile.Profile() if args.profile else None
     with tempfile.TemporaryDirectory() as out:
         t0 = time.perf_counter()

@@ -96,9 +96,19 @@ def main() -> None:
     parser.add_argument("--world", default="city")
     parser.add_argument("--scenario", default="small")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--carving-spacing", type=float, help="thinned free-space carving (cells; default exact)"
+    )
     args = parser.parse_args()
 
-    config = make_config({"world": args.world, "scenario": args.scenario, "seed": args.seed})
+    config = make_config(
+        {
+            "world": args.world,
+            "scenario": args.scenario,
+            "seed": args.seed,
+            "map_carving_spacing": args.carving_spacing,
+        }
+    )
     registry = _Registry()
     with tempfile.TemporaryDirectory() as out, staged(registry):
         start = time.perf_counter()
