@@ -17,6 +17,7 @@ import pstats
 import tempfile
 import time
 
+from mission_profile import outcome
 from seminspect.missions.config import make_config
 from seminspect.missions.run import run_mission
 
@@ -55,6 +56,7 @@ def main() -> None:
     factor = mission.sim_time_s / wall
     name = f"{args.world} {args.scenario} seed {args.seed}"
     print(f"mission {name}: {result.state} ({result.reason})")
+    print(outcome(result.metrics))
     print(
         f"simulated {mission.sim_time_s:.0f} s in {wall:.1f} s wall: {factor:.1f}x real time "
         f"(target {TARGET_FACTOR:.0f}x: {'met' if factor >= TARGET_FACTOR else 'missed'})"

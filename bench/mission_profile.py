@@ -69,6 +69,16 @@ class _Registry:
         return wrapper
 
 
+def outcome(figures: metrics.MissionMetrics) -> str:
+    """The mission's results, to compare settings that may change them."""
+    rmse = figures.table6.localisation_rmse_m
+    return (
+        f"targets detected {figures.table3.detected_pct:.0f} %, inspected "
+        f"{figures.table3.inspected_pct:.0f} % of detected; localisation RMSE "
+        f"{'-' if rmse is None else f'{rmse:.3f} m'}; {figures.mission.distance_m:.0f} m driven"
+    )
+
+
 @contextmanager
 def staged(registry: _Registry) -> Iterator[None]:
     """Wrap the stage functions and capture the mission's timers, for the block only."""
@@ -114,7 +124,9 @@ def main() -> None:
         start = time.perf_counter()
         result = run_mission(config, f"{out}/run")
         wall = time.perf_counter() - start
-    mission = result.metrics["mission"]
+    figures = result.metrics
+    assert figures is not None, f"the mission stopped before its figures: {result.reason}"
+    mission = figures.mission
     seconds = registry.seconds()
     with suppress(KeyError):
         seconds["sensing (other)"] = seconds.pop("sensing")
@@ -122,10 +134,11 @@ def main() -> None:
     casting = seconds.get("ray casting", 0.0)
     print(f"mission {args.world} {args.scenario} seed {args.seed}: {result.state}")
     print(
-        f"simulated {mission['sim_time_s']:.0f} s in {wall:.1f} s wall: "
-        f"{mission['sim_time_s'] / wall:.1f}x real time; {mission['frames']} frames, "
-        f"{mission['lidar_scans']} scans"
+        f"simulated {mission.sim_time_s:.0f} s in {wall:.1f} s wall: "
+        f"{mission.sim_time_s / wall:.1f}x real time; {mission.frames} frames, "
+        f"{mission.lidar_scans} scans"
     )
+    print(outcome(figures))
     print(f"{'stage':<22} {'seconds':>8} {'share':>7}")
     for stage, value in sorted(seconds.items(), key=lambda item: -item[1]):
         print(f"{stage:<22} {value:8.2f} {100 * value / wall:6.1f}%")
