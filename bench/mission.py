@@ -35,14 +35,10 @@ def main() -> None:
     parser.add_argument("--profile", action="store_true", help="also print the top functions")
     args = parser.parse_args()
 
-    config = make_config(
-        {
-            "world": args.world,
-            "scenario": args.scenario,
-            "seed": args.seed,
-            "map_carving_spacing": args.carving_spacing,
-        }
-    )
+    settings = {"world": args.world, "scenario": args.scenario, "seed": args.seed}
+    if args.carving_spacing is not None:  # left out otherwise: the script also runs older code
+        settings["map_carving_spacing"] = args.carving_spacing
+    config = make_config(settings)
     profiler = cProfile.Profile() if args.profile else None
     with tempfile.TemporaryDirectory() as out:
         t0 = time.perf_counter()

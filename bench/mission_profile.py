@@ -111,14 +111,10 @@ def main() -> None:
     )
     args = parser.parse_args()
 
-    config = make_config(
-        {
-            "world": args.world,
-            "scenario": args.scenario,
-            "seed": args.seed,
-            "map_carving_spacing": args.carving_spacing,
-        }
-    )
+    settings = {"world": args.world, "scenario": args.scenario, "seed": args.seed}
+    if args.carving_spacing is not None:  # left out otherwise: the script also runs older code
+        settings["map_carving_spacing"] = args.carving_spacing
+    config = make_config(settings)
     registry = _Registry()
     with tempfile.TemporaryDirectory() as out, staged(registry):
         start = time.perf_counter()
