@@ -262,12 +262,11 @@ class VoxelMap:
         With ``carving_spacing`` (cells) free space is carved by thinned beams near the sensor
         (``mapping.carving``, along each ring's columns: approximate, faster).
         """
-        returns = scan.points - scan.origin
         self.integrate_rays(
             scan.origin,
             scan.points,
             np.ones(len(scan.points), dtype=bool),
-            self._thinned_starts(returns, np.linalg.norm(returns, axis=1), carving_spacing),
+            self._thinned_starts(scan.points - scan.origin, carving_spacing),
         )
         if clear_misses_to is None or not len(scan.misses):
             return
@@ -275,24 +274,26 @@ class VoxelMap:
             raise InvalidInputError(
                 f"clear_misses_to must be in (0, {scan.max_range}] m, got {clear_misses_to}"
             )
-        misses = scan.misses.astype(np.float64)
+        reaches = scan.misses.astype(np.float64) * clear_misses_to
         self.integrate_rays(
             scan.origin,
-            scan.origin + misses * clear_misses_to,
-            np.zeros(len(misses), dtype=bool),
-            self._thinned_starts(misses, np.full(len(misses), clear_misses_to), carving_spacing),
+            scan.origin + reaches,
+            np.zeros(len(reaches), dtype=bool),
+            self._thinned_starts(reaches, carving_spacing),
         )
 
     def _thinned_starts(
-        self, directions: NDArray[np.float64], lengths: NDArray[np.float64], spacing: float | None
+        self, rays: NDArray[np.float64], spacing: float | None
     ) -> NDArray[np.float64] | None:
-        """Carving starts for beams listed along a LiDAR's rings, thinned by their order."""
+        """Carving starts for beams (``rays``: end minus origin) listed along a LiDAR's rings,
+        thinned by their order; None (exact) without a spacing."""
         if spacing is None:
             return None
-        step = carving.median_step(directions)
+        step = carving.median_step(rays)
         if not (math.isfinite(step) and step > 0):
             return None  # too few beams to thin
-        levels = carving.index_levels(np.arange(len(directions)))
+        levels = carving.index_levels(np.arange(len(rays)))
+        lengths = np.linalg.norm(rays, axis=1)
         return carving.carve_from(levels, lengths, step, self.resolution, spacing)
 
     def inflated(self, radius: float) -> VoxelMap:
