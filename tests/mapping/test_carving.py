@@ -8,7 +8,13 @@ import pytest
 
 from seminspect.core.errors import InvalidInputError
 from seminspect.geometry.transforms import quat_from_yaw
-from seminspect.mapping.carving import MAX_LEVEL, carve_from, index_levels, median_step
+from seminspect.mapping.carving import (
+    MAX_LEVEL,
+    carve_from,
+    index_levels,
+    median_step,
+    order_levels,
+)
 from seminspect.mapping.voxel import FREE, OCCUPIED, VoxelMap
 from seminspect.sensors import CameraModel, Lidar, render
 from seminspect.worlds import generate_world
@@ -20,6 +26,12 @@ MISSING_FREE_TOLERANCE = 0.02
 def test_levels_count_trailing_zero_bits_up_to_the_top_level() -> None:
     index = np.array([1, 2, 3, 4, 6, 8, 12, -4, 0, 2**MAX_LEVEL, 2 ** (MAX_LEVEL + 3)])
     assert index_levels(index).tolist() == [0, 1, 0, 2, 1, 3, 2, 2] + [MAX_LEVEL] * 3
+
+
+def test_levels_by_order_are_those_of_the_indices_and_read_only() -> None:
+    levels = order_levels(100)
+    np.testing.assert_array_equal(levels, index_levels(np.arange(100)))
+    assert order_levels(100) is levels and not levels.flags.writeable
 
 
 def test_rays_start_where_the_next_level_spreads_beyond_the_spacing() -> None:
@@ -43,10 +55,11 @@ def test_the_median_step_along_lidar_rings_is_their_column_step() -> None:
     """Columns are the column step apart on the horizon ring, cos(elevation) of it above."""
     lidar = Lidar()
     directions, _ = lidar.rays
-    step = median_step(directions.astype(np.float64))
+    rays = 20.0 * directions.astype(np.float64)
+    step = median_step(rays, np.full(len(rays), 20.0))
     column = math.radians(lidar.horizontal_resolution_deg)
     assert column * math.cos(math.radians(lidar.max_elevation_deg)) < step < column
-    assert median_step(directions[:1]) == math.inf
+    assert median_step(rays[:1], np.ones(1)) == math.inf
 
 
 @pytest.fixture(scope="module")

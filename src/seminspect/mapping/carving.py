@@ -21,6 +21,8 @@ cautious. The mission's ``map_carving_spacing`` option turns it on.
 
 from __future__ import annotations
 
+from functools import cache
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -28,6 +30,17 @@ from seminspect.core.errors import InvalidInputError
 
 #: Every ``2**MAX_LEVEL``-th ray frees cells all the way from the sensor.
 MAX_LEVEL = 6
+#: :func:`median_step` looks at every this-many-th pair of consecutive rays.
+STEP_SAMPLE = 8
+
+
+@cache
+def order_levels(count: int) -> NDArray[np.int64]:
+    """:func:`index_levels` of ``0 .. count - 1`` (rays thinned by the order they come in),
+    kept per count: a LiDAR's scans keep coming with the same few lengths."""
+    levels = index_levels(np.arange(count))
+    levels.flags.writeable = False
+    return levels
 
 
 def index_levels(index: NDArray[np.integer]) -> NDArray[np.int64]:
@@ -67,11 +80,14 @@ def carve_from(
     return np.minimum(start / np.maximum(length, 1e-12), 1.0)
 
 
-def median_step(directions: NDArray[np.floating]) -> float:
-    """The median angle between consecutive rays (radians): the grid's step along the order
-    in which a sensor lists its rays (a LiDAR's columns within each ring)."""
-    if len(directions) < 2:
+def median_step(rays: NDArray[np.floating], lengths: NDArray[np.floating]) -> float:
+    """The median angle between consecutive rays (radians; ``rays`` of ``lengths``): the
+    grid's step along the order in which a sensor lists its rays (a LiDAR's columns within
+    each ring). The median is taken of the cosines, a monotonic stand-in for the angles, of
+    every :data:`STEP_SAMPLE`-th pair: plenty for a median, and a scan has tens of thousands."""
+    if len(rays) < 2:
         return float("inf")
-    unit = directions / np.linalg.norm(directions, axis=1, keepdims=True)
-    cosine = np.einsum("ij,ij->i", unit[1:], unit[:-1])
-    return float(np.median(np.arccos(np.clip(cosine, -1.0, 1.0))))
+    first, second = slice(0, -1, STEP_SAMPLE), slice(1, None, STEP_SAMPLE)
+    dots = np.einsum("ij,ij->i", rays[first], rays[second])
+    cosine = dots / (lengths[first] * lengths[second])
+    return float(np.arccos(np.clip(np.median(cosine), -1.0, 1.0)))

@@ -289,11 +289,11 @@ class VoxelMap:
         thinned by their order; None (exact) without a spacing."""
         if spacing is None:
             return None
-        step = carving.median_step(rays)
+        lengths = np.sqrt(np.einsum("ij,ij->i", rays, rays))
+        step = carving.median_step(rays, lengths)
         if not (math.isfinite(step) and step > 0):
             return None  # too few beams to thin
-        levels = carving.index_levels(np.arange(len(rays)))
-        lengths = np.linalg.norm(rays, axis=1)
+        levels = carving.order_levels(len(rays))
         return carving.carve_from(levels, lengths, step, self.resolution, spacing)
 
     def inflated(self, radius: float) -> VoxelMap:
