@@ -1,5 +1,5 @@
 # Entry points for a fresh machine; each builds the virtual environment it needs.
-#   make mission     install seminspect and run the default inspection mission
+#   make mission     install seminspect, compile its kernels, run the default inspection mission
 #   make test        install seminspect with test tools and run the test suite
 #   make reproduce   regenerate every measured table of docs/reproduction.md (hours)
 #   make lock        rewrite requirements.lock from the versions installed in .venv
@@ -24,7 +24,18 @@ $(VENV)/.installed-test: pyproject.toml $(LOCK) | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -c $(LOCK) -e '.[test]'
 	touch $@ $(VENV)/.installed-run
 
-mission: $(VENV)/.installed-run
+# numba compiles each kernel on its first call and caches it beside the source. One short
+# mission right after install compiles what missions use, so that the first mission a user
+# runs starts warm: the compilation (tens of seconds) moves from that mission to the install.
+WARM_UP_RUN := $(VENV)/warm-up-run
+$(VENV)/.compiled: $(VENV)/.installed-run
+	rm -rf $(WARM_UP_RUN)
+	$(BIN)/seminspect mission --world city --scenario small --budget 300 --no-pictures \
+		--out $(WARM_UP_RUN) > /dev/null
+	rm -rf $(WARM_UP_RUN)
+	touch $@
+
+mission: $(VENV)/.compiled
 	$(BIN)/seminspect mission
 
 test: $(VENV)/.installed-test

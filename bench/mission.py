@@ -17,6 +17,7 @@ import pstats
 import tempfile
 import time
 
+from mission_profile import outcome
 from seminspect.missions.config import make_config
 from seminspect.missions.run import run_mission
 
@@ -28,10 +29,16 @@ def main() -> None:
     parser.add_argument("--world", default="city")
     parser.add_argument("--scenario", default="large")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--carving-spacing", type=float, help="thinned free-space carving (cells; default exact)"
+    )
     parser.add_argument("--profile", action="store_true", help="also print the top functions")
     args = parser.parse_args()
 
-    config = make_config({"world": args.world, "scenario": args.scenario, "seed": args.seed})
+    settings = {"world": args.world, "scenario": args.scenario, "seed": args.seed}
+    if args.carving_spacing is not None:  # left out otherwise: the script also runs older code
+        settings["map_carving_spacing"] = args.carving_spacing
+    config = make_config(settings)
     profiler = cProfile.Profile() if args.profile else None
     with tempfile.TemporaryDirectory() as out:
         t0 = time.perf_counter()
@@ -45,6 +52,7 @@ def main() -> None:
     factor = mission.sim_time_s / wall
     name = f"{args.world} {args.scenario} seed {args.seed}"
     print(f"mission {name}: {result.state} ({result.reason})")
+    print(outcome(result.metrics))
     print(
         f"simulated {mission.sim_time_s:.0f} s in {wall:.1f} s wall: {factor:.1f}x real time "
         f"(target {TARGET_FACTOR:.0f}x: {'met' if factor >= TARGET_FACTOR else 'missed'})"

@@ -36,6 +36,7 @@ def test_the_frontier_explorer_runs_from_the_command_line(capsys, tmp_path: Path
         (("mission", "--preset", "urban"), "preset"),
         (("mission", "--seed", "-3"), "--seed"),
         (("mission", "--planner", "gbplanner"), "--planner"),
+        (("mission", "--carving-spacing", "9"), "--carving-spacing"),
     ],
 )
 def test_bad_mission_settings_exit_non_zero_with_one_line(capsys, tmp_path, args, message) -> None:

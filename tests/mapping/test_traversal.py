@@ -1,4 +1,5 @@
-"""The allocation-free ray walk against the array-based walk it replaced, cell for cell."""
+"""The allocation-free ray walk against the array-based walk it replaced, cell for cell,
+and walks that start part way along their rays (thinned carving)."""
 
 import math
 
@@ -86,6 +87,37 @@ def test_walk_marks_the_same_cells_as_the_reference(shared_origin, seed) -> None
     states = expected.copy()
     origins, ends, hit = _random_rays(rng, 600, shared_origin)
     _reference(expected, (grid_origin, resolution), origins, ends, hit)
-    integrate_rays_kernel(states, grid_origin, resolution, origins, ends, hit)
+    integrate_rays_kernel(states, grid_origin, resolution, origins, ends, hit, np.zeros(0))
     assert (expected == FREE).sum() > 1000 and (expected == OCCUPIED).sum() > 200
     np.testing.assert_array_equal(states, expected)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_walks_started_part_way_free_a_subset_of_the_full_walks_cells(seed) -> None:
+    """Off cell borders; on one, a walk that starts part way may break a tie the other way."""
+    rng = np.random.default_rng(seed)
+    grid_origin, resolution = np.array([0.0, 0.0, 0.0]), 0.25
+    origins, ends, hit = _random_rays(rng, 600, shared_origin=True)
+    ends += rng.normal(0.0, 1e-3, ends.shape)
+    full = np.zeros((24, 20, 16), dtype=np.uint8)
+    integrate_rays_kernel(full, grid_origin, resolution, origins, ends, hit, np.zeros(0))
+    from_origin = np.zeros_like(full)
+    integrate_rays_kernel(from_origin, grid_origin, resolution, origins, ends, hit, np.zeros(600))
+    part = np.zeros_like(full)
+    integrate_rays_kernel(part, grid_origin, resolution, origins, ends, hit, rng.random(600))
+    np.testing.assert_array_equal(from_origin, full)
+    assert np.array_equal(part == OCCUPIED, full == OCCUPIED)
+    assert not np.any((part == FREE) & (full != FREE))
+    assert (part == FREE).sum() < 0.9 * (full == FREE).sum()
+
+
+def test_walks_started_at_their_end_only_set_their_end_cells() -> None:
+    grid_origin, resolution = np.array([0.0, 0.0, 0.0]), 1.0
+    states = np.zeros((10, 4, 4), dtype=np.uint8)
+    ends = np.array([[8.5, 1.5, 1.5], [6.5, 2.5, 2.5]])
+    origins = np.array([[0.5, 1.5, 1.5]])
+    integrate_rays_kernel(
+        states, grid_origin, resolution, origins, ends, np.array([True, False]), np.ones(2)
+    )
+    assert states[8, 1, 1] == OCCUPIED and states[6, 2, 2] == FREE
+    assert np.count_nonzero(states) == 2

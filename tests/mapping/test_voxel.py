@@ -273,3 +273,11 @@ def test_maps_round_trip_and_bad_files_are_refused(tmp_path) -> None:
     )
     with pytest.raises(FileFormatError, match="0, 1, 2"):
         load_map(tmp_path / "bad.npz")
+
+
+def test_a_map_over_a_strided_view_is_kept_c_ordered_and_integrates_rays() -> None:
+    wide = np.zeros((8, 6, 4), dtype=np.uint8)
+    grid = VoxelMap(np.zeros(3), 0.5, wide[::2])
+    assert grid.states.flags.c_contiguous and grid.shape == (4, 6, 4)
+    grid.integrate_rays([0.1, 0.1, 0.1], [[1.9, 0.1, 0.1]], [True])
+    assert grid.states[3, 0, 0] == OCCUPIED and grid.states[:3, 0, 0].tolist() == [FREE] * 3

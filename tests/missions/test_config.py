@@ -44,6 +44,7 @@ def test_explicit_settings_win_over_defaults() -> None:
         ({"mode": "swimming"}, "mode"),
         ({"time_budget_s": 0}, "time_budget_s"),
         ({"robot": {"radius": -1}}, "robot.radius"),
+        ({"map_carving_spacing": 0}, "map_carving_spacing"),
         ({"warp_drive": True}, "warp_drive"),
     ],
 )

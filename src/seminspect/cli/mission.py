@@ -61,6 +61,14 @@ def app(
     budget: float | None = typer.Option(
         None, "--budget", help="Time budget in simulated seconds (default: 000 Sec VII-D's).", min=1
     ),
+    carving_spacing: float | None = typer.Option(
+        None,
+        "--carving-spacing",
+        help="Approximate, faster mapping: near the sensor only rays this many cells apart "
+        "carve free space (default: every ray).",
+        min=0.01,
+        max=4.0,
+    ),
     out: Path | None = typer.Option(
         None, "--out", "-o", help="Run directory (default: runs/<name>)."
     ),
@@ -98,6 +106,7 @@ def app(
                 "world": _world_argument(world), "scenario": scenario, "seed": seed,
                 "preset": preset, "mode": None if mode is None else mode.value,
                 "noise": noise.value, "planner": planner.value, "time_budget_s": budget,
+                "map_carving_spacing": carving_spacing,
             }
         )  # fmt: skip
         if out is not None:
@@ -141,6 +150,7 @@ def _resumed(ctx: typer.Context, run_dir: Path):
             "noise",
             "planner",
             "budget",
+            "carving_spacing",
             "out",
         )
         if getattr(ctx.get_parameter_source(name), "name", "DEFAULT") != "DEFAULT"

@@ -14,6 +14,7 @@ import math
 import numba
 import numpy as np
 
+UNKNOWN = np.uint8(0)
 FREE = np.uint8(1)
 OCCUPIED = np.uint8(2)
 
@@ -28,13 +29,6 @@ def _clip_axis(t0: float, t1: float, o: float, d: float, size: int) -> tuple[flo
     ta = (0.0 - o) / d
     tb = (size - o) / d
     return max(t0, min(ta, tb)), min(t1, max(ta, tb))
-
-
-@numba.njit(cache=True, inline="always")
-def _mark(states: np.ndarray, i: int, j: int, k: int, value: np.uint8) -> None:
-    """Set a cell, except that nothing overwrites OCCUPIED."""
-    if states[i, j, k] != OCCUPIED:
-        states[i, j, k] = value
 
 
 @numba.njit(cache=True, inline="always")
@@ -55,20 +49,20 @@ def _cell(x: float, size: int) -> int:
 
 @numba.njit(cache=True, inline="always")
 def _advance(  # noqa: PLR0917 - inlined into the walk
-    cell: int, boundary: float, per_cell: float, step: int, size: int, t1: float
+    cell: int, boundary: float, per_cell: float, step: int, edge: int, t1: float
 ) -> tuple[int, float, bool]:
-    """Step one cell along an axis; False once the ray ends or leaves the grid first."""
+    """Step one cell along an axis; False once the ray ends first or the step reaches
+    ``edge``, the index just past the grid."""
     if boundary > t1:
         return cell, boundary, False
     cell += step
-    if cell < 0 or cell >= size:
-        return cell, boundary, False
-    return cell, boundary + per_cell, True
+    return cell, boundary + per_cell, cell != edge
 
 
 @numba.njit(cache=True)
 def _walk(  # noqa: PLR0917 - scalars keep the per-ray walk free of allocations
-    states: np.ndarray,
+    cells: np.ndarray,
+    shape: tuple[int, int, int],
     ox: float,
     oy: float,
     oz: float,
@@ -76,14 +70,19 @@ def _walk(  # noqa: PLR0917 - scalars keep the per-ray walk free of allocations
     dy: float,
     dz: float,
     hit: bool,
+    t_start: float,
 ) -> None:
-    """Free every cell from the grid entry of ``o + t d`` to its end; occupy the end on a hit.
+    """Free every cell of ``o + t d`` for ``t`` from ``t_start`` (clipped to the grid) to 1;
+    occupy the end cell on a hit.
 
-    Three scalars per axis rather than small arrays: the walk runs once per ray, and
-    allocating its state dominated short rays.
+    ``cells`` is the map's C-ordered states, flattened: the walk moves one index by the
+    axis strides instead of indexing in 3D, and writes a cell only when it is still unknown
+    (most cells near the sensor were freed by earlier rays). Three scalars per axis rather
+    than small arrays: the walk runs once per ray, and allocating its state dominated short
+    rays.
     """
-    nx, ny, nz = states.shape
-    t0, t1 = _clip_axis(0.0, 1.0, ox, dx, nx)
+    nx, ny, nz = shape
+    t0, t1 = _clip_axis(t_start, 1.0, ox, dx, nx)
     t0, t1 = _clip_axis(t0, t1, oy, dy, ny)
     t0, t1 = _clip_axis(t0, t1, oz, dz, nz)
     if t0 > t1:
@@ -94,22 +93,31 @@ def _walk(  # noqa: PLR0917 - scalars keep the per-ray walk free of allocations
     sj, mj, dj = _start_axis(oy, dy, j)
     sk, mk, dk = _start_axis(oz, dz, k)
     occupy_end = hit and 0.0 <= ox + dx < nx and 0.0 <= oy + dy < ny and 0.0 <= oz + dz < nz
+    # The index one step past the grid on each axis, in the direction the walk moves.
+    ei, ej, ek = (nx if si > 0 else -1), (ny if sj > 0 else -1), (nz if sk > 0 else -1)
+    index, last = (i * ny + j) * nz + k, (li * ny + lj) * nz + lk
     for _ in range(nx + ny + nz + 3):
-        if i == li and j == lj and k == lk:
+        if index == last:
             break
-        _mark(states, i, j, k, FREE)
-        # The axis whose next boundary comes first; ties go to the lower axis.
+        if cells[index] == UNKNOWN:
+            cells[index] = FREE
+        # The axis whose next boundary comes first; ties go to the lower axis. The walk
+        # stops once the ray ends inside the current cell or steps off the grid.
         axis = (2 if mk < mj else 1) if mj < mi else (2 if mk < mi else 0)
         if axis == 0:
-            i, mi, inside = _advance(i, mi, di, si, nx, t1)
+            i, mi, inside = _advance(i, mi, di, si, ei, t1)
+            index += si * ny * nz
         elif axis == 1:
-            j, mj, inside = _advance(j, mj, dj, sj, ny, t1)
+            j, mj, inside = _advance(j, mj, dj, sj, ej, t1)
+            index += sj * nz
         else:
-            k, mk, inside = _advance(k, mk, dk, sk, nz, t1)
+            k, mk, inside = _advance(k, mk, dk, sk, ek, t1)
+            index += sk
         if not inside:
             break
     # The end cell is set even when rounding let the walk slip past it along an edge or corner.
-    _mark(states, li, lj, lk, OCCUPIED if occupy_end else FREE)
+    if cells[last] != OCCUPIED:
+        cells[last] = OCCUPIED if occupy_end else FREE
 
 
 @numba.njit(cache=True)
@@ -120,8 +128,16 @@ def integrate_rays_kernel(  # noqa: PLR0917 - a compiled kernel takes its arrays
     origins: np.ndarray,
     ends: np.ndarray,
     hit: np.ndarray,
+    carve_from: np.ndarray,
 ) -> None:
-    """Walk every ray ``origins[r or 0] -> ends[r]`` (world metres) through ``states``."""
+    """Walk every ray ``origins[r or 0] -> ends[r]`` (world metres) through ``states``.
+
+    ``carve_from[r]`` in ``[0, 1]`` is the fraction of ray ``r`` before which it frees nothing
+    (see ``mapping.carving``); an empty array frees every ray from its origin.
+    """
+    thinned = carve_from.shape[0] > 0
+    cells = states.reshape(-1)
+    shape = states.shape
     shared = origins.shape[0] == 1
     for r in range(ends.shape[0]):
         src = origins[0] if shared else origins[r]
@@ -129,7 +145,8 @@ def integrate_rays_kernel(  # noqa: PLR0917 - a compiled kernel takes its arrays
         oy = (src[1] - grid_origin[1]) / resolution
         oz = (src[2] - grid_origin[2]) / resolution
         _walk(
-            states,
+            cells,
+            shape,
             ox,
             oy,
             oz,
@@ -137,4 +154,5 @@ def integrate_rays_kernel(  # noqa: PLR0917 - a compiled kernel takes its arrays
             (ends[r, 1] - grid_origin[1]) / resolution - oy,
             (ends[r, 2] - grid_origin[2]) / resolution - oz,
             hit[r],
+            carve_from[r] if thinned else 0.0,
         )

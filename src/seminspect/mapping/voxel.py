@@ -27,6 +27,7 @@ from seminspect.core.io import save_npz_atomic
 from seminspect.core.threads import rotate_rows
 from seminspect.geometry.raster import cells_touching_triangles
 from seminspect.geometry.transforms import as_point, as_points
+from seminspect.mapping import carving
 from seminspect.mapping.semantic_cloud import read_npz
 from seminspect.mapping.traversal import integrate_rays_kernel
 from seminspect.sensors import Frame, LidarScan
@@ -49,7 +50,8 @@ class VoxelMap:
     Attributes:
         origin: world coordinates of the grid's minimum corner (metres).
         resolution: edge length of a cell (metres).
-        states: ``uint8`` array of shape ``(nx, ny, nz)`` holding UNKNOWN, FREE or OCCUPIED.
+        states: ``uint8`` array of shape ``(nx, ny, nz)`` holding UNKNOWN, FREE or OCCUPIED,
+            kept C-ordered (a strided view is copied) so the ray walk can step through it flat.
     """
 
     origin: NDArray[np.float64]
@@ -63,6 +65,7 @@ class VoxelMap:
         self.resolution = float(self.resolution)
         if self.states.ndim != 3 or self.states.dtype != np.uint8:
             raise InvalidInputError("voxel states must be a 3D uint8 array")
+        self.states = np.ascontiguousarray(self.states)
 
     @classmethod
     def empty(cls, lower: ArrayLike, upper: ArrayLike, resolution: float) -> VoxelMap:
@@ -168,7 +171,13 @@ class VoxelMap:
             grid.states[a[0] : b[0], a[1] : b[1], a[2] : b[2]] = OCCUPIED
         return grid
 
-    def integrate_rays(self, origins: ArrayLike, endpoints: ArrayLike, hit: ArrayLike) -> None:
+    def integrate_rays(
+        self,
+        origins: ArrayLike,
+        endpoints: ArrayLike,
+        hit: ArrayLike,
+        carve_from: NDArray[np.float64] | None = None,
+    ) -> None:
         """Clear the cells along each ray and mark the end cell of every hit occupied.
 
         Args:
@@ -176,6 +185,8 @@ class VoxelMap:
             endpoints: ``(N, 3)`` ray ends: the surface point for hits, the end of the sensor's
                 range for rays that saw nothing.
             hit: ``(N,)`` whether each ray ended on a surface.
+            carve_from: ``(N,)`` fraction of each ray before which it frees nothing
+                (thinned carving, ``mapping.carving``); None frees every ray from its origin.
         """
         ends = as_points(endpoints, "ray end points", allow_empty=True)
         start = np.asarray(origins, dtype=np.float64)
@@ -187,14 +198,27 @@ class VoxelMap:
         flags = np.asarray(hit, dtype=bool).reshape(-1)
         if flags.shape != (len(ends),):
             raise InvalidInputError(f"{flags.size} hit flags for {len(ends)} rays")
+        starts = np.zeros(0) if carve_from is None else np.asarray(carve_from, dtype=np.float64)
+        if starts.size and starts.shape != (len(ends),):
+            raise InvalidInputError(f"{starts.size} carving starts for {len(ends)} rays")
         if len(ends):
-            integrate_rays_kernel(self.states, self.origin, self.resolution, start, ends, flags)
+            integrate_rays_kernel(
+                self.states, self.origin, self.resolution, start, ends, flags, starts
+            )
 
-    def integrate_frame(self, frame: Frame, stride: int = 4, use_odometry: bool = False) -> None:
+    def integrate_frame(
+        self,
+        frame: Frame,
+        stride: int = 4,
+        use_odometry: bool = False,
+        carving_spacing: float | None = None,
+    ) -> None:
         """Integrate every ``stride``-th pixel of a depth frame (rows and columns).
 
         Pixels that saw nothing clear their ray up to the camera's range. With
-        ``use_odometry`` the rays start from the pose the robot believed it had.
+        ``use_odometry`` the rays start from the pose the robot believed it had. With
+        ``carving_spacing`` (cells) free space is carved by thinned rays near the camera
+        (``mapping.carving``: approximate, faster); None walks every ray from the camera.
         """
         if not (isinstance(stride, int) and stride >= 1):
             raise InvalidInputError(f"stride must be a positive integer, got {stride!r}")
@@ -212,24 +236,65 @@ class VoxelMap:
         )
         rotation = Rotation.from_quat(orientation).as_matrix()
         ends = position + rotate_rows(directions[flat] * length[:, None], rotation)
-        self.integrate_rays(position, ends, hit)
+        starts = None
+        if carving_spacing is not None:
+            # Neighbouring pixels of the strided grid are stride / fx radians apart at the centre,
+            # the widest step of a pinhole camera.
+            levels = np.minimum(
+                carving.index_levels(rows.ravel() // stride),
+                carving.index_levels(cols.ravel() // stride),
+            )
+            step = stride / frame.camera.fx
+            starts = carving.carve_from(levels, length, step, self.resolution, carving_spacing)
+        self.integrate_rays(position, ends, hit, starts)
 
-    def integrate_scan(self, scan: LidarScan, clear_misses_to: float | None = None) -> None:
+    def integrate_scan(
+        self,
+        scan: LidarScan,
+        clear_misses_to: float | None = None,
+        carving_spacing: float | None = None,
+    ) -> None:
         """Integrate a LiDAR scan: each return clears its ray and marks its end occupied.
 
         With ``clear_misses_to`` (metres, at most the sensor's range), beams that returned
         nothing also clear free space out to that distance, as OctoMap's max-range insertion
         does: open sky and far, empty streets become known free rather than staying unknown.
+        With ``carving_spacing`` (cells) free space is carved by thinned beams near the sensor
+        (``mapping.carving``, along each ring's columns: approximate, faster).
         """
-        self.integrate_rays(scan.origin, scan.points, np.ones(len(scan.points), dtype=bool))
+        self.integrate_rays(
+            scan.origin,
+            scan.points,
+            np.ones(len(scan.points), dtype=bool),
+            self._thinned_starts(scan.points - scan.origin, carving_spacing),
+        )
         if clear_misses_to is None or not len(scan.misses):
             return
         if not (math.isfinite(clear_misses_to) and 0 < clear_misses_to <= scan.max_range):
             raise InvalidInputError(
                 f"clear_misses_to must be in (0, {scan.max_range}] m, got {clear_misses_to}"
             )
-        ends = scan.origin + scan.misses.astype(np.float64) * clear_misses_to
-        self.integrate_rays(scan.origin, ends, np.zeros(len(ends), dtype=bool))
+        reaches = scan.misses.astype(np.float64) * clear_misses_to
+        self.integrate_rays(
+            scan.origin,
+            scan.origin + reaches,
+            np.zeros(len(reaches), dtype=bool),
+            self._thinned_starts(reaches, carving_spacing),
+        )
+
+    def _thinned_starts(
+        self, rays: NDArray[np.float64], spacing: float | None
+    ) -> NDArray[np.float64] | None:
+        """Carving starts for beams (``rays``: end minus origin) listed along a LiDAR's rings,
+        thinned by their order; None (exact) without a spacing."""
+        if spacing is None:
+            return None
+        lengths = np.sqrt(np.einsum("ij,ij->i", rays, rays))
+        step = carving.median_step(rays, lengths)
+        if not (math.isfinite(step) and step > 0):
+            return None  # too few beams to thin
+        levels = carving.order_levels(len(rays))
+        return carving.carve_from(levels, lengths, step, self.resolution, spacing)
 
     def inflated(self, radius: float) -> VoxelMap:
         """A copy where every cell within ``radius`` of an occupied cell is occupied.

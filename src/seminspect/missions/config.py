@@ -94,6 +94,13 @@ class MissionConfig(_Strict):
         None, gt=0, allow_inf_nan=False, description="simulated seconds"
     )
     map_resolution: float = Field(0.3, ge=0.1, le=1.0, description="robot's occupancy map [m]")
+    map_carving_spacing: float | None = Field(
+        None,
+        gt=0,
+        le=4,
+        description="thin the rays that carve free space near the sensor to this many cells "
+        "apart (mapping.carving: faster, a few free cells stay unknown); None: every ray, exact",
+    )
     target_classes: tuple[str, ...] | None = None
     feature_labels: tuple[str, ...] | None = None
     localisation: Literal["median", "cluster"] = "cluster"

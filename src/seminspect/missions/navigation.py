@@ -66,6 +66,8 @@ class Navigator:
         on_frame: called with every camera frame taken while driving.
         lidar_every_m, camera_every_m: sensing intervals while driving.
         clear_misses_to: free space is cleared along LiDAR beams with no return up to this range.
+        carving_spacing: thinned free-space carving of scans (cells, ``mapping.carving``);
+            None carves along every beam.
         timers: where sensing, planning and driving time is charged.
         charge_planning_time: the robot waits for each route's planning wall time.
     """
@@ -80,6 +82,7 @@ class Navigator:
         lidar_every_m: float,
         camera_every_m: float,
         clear_misses_to: float,
+        carving_spacing: float | None = None,
         timers: Timers | None = None,
         charge_planning_time: bool = False,
     ) -> None:
@@ -92,6 +95,7 @@ class Navigator:
         self.lidar_every_m = lidar_every_m
         self.camera_every_m = camera_every_m
         self.clear_misses_to = clear_misses_to
+        self.carving_spacing = carving_spacing
         self.stats = NavigationStats()
         #: The same planner kept to observed free space, for short moves beside structures.
         self.known_planner = LocalPlanner(
@@ -108,7 +112,11 @@ class Navigator:
         """Scan, update the map, and keep the scan as :attr:`last_scan`."""
         with self.timers("sensing"):
             self.last_scan = self.platform.scan()
-            self.occupancy.integrate_scan(self.last_scan, clear_misses_to=self.clear_misses_to)
+            self.occupancy.integrate_scan(
+                self.last_scan,
+                clear_misses_to=self.clear_misses_to,
+                carving_spacing=self.carving_spacing,
+            )
         return self.last_scan
 
     def mark_contact(self, contact: NDArray[np.float64] | None) -> None:

@@ -33,6 +33,20 @@ def test_a_point_set_keeps_one_point_per_voxel_and_answers_radius_queries() -> N
     assert near.tolist() == [True, False]
 
 
+def test_adding_views_keeps_the_first_point_of_each_voxel_in_order() -> None:
+    """The set grown view by view equals deduplicating all the points at once."""
+    rng = np.random.default_rng(0)
+    batches = [rng.uniform(-1.0, 1.0, (n, 3)) for n in (300, 0, 500, 200)]
+    batches.append(batches[0][:50] + 0.01)  # revisits voxels already held
+    grown = PointSet(0.2)
+    for batch in batches:
+        grown.add(batch)
+    everything = np.vstack(batches)
+    _, first = np.unique(np.floor(everything / 0.2).astype(np.int64), axis=0, return_index=True)
+    np.testing.assert_array_equal(grown.points, everything[np.sort(first)])
+    assert 0 < grown.size < len(everything)
+
+
 def test_lidar_returns_attached_to_the_target_join_its_surface() -> None:
     platform = FakePlatform()
     track = tracker(platform)

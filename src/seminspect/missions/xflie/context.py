@@ -70,7 +70,12 @@ class MissionContext:
     def integrate(self, frame: Frame) -> None:
         """Put a frame's depth into the map."""
         with self.timers("sensing"):
-            self.occupancy.integrate_frame(frame, stride=DEPTH_STRIDE, use_odometry=True)
+            self.occupancy.integrate_frame(
+                frame,
+                stride=DEPTH_STRIDE,
+                use_odometry=True,
+                carving_spacing=self.config.map_carving_spacing,
+            )
         self.frames_seen += 1
 
     def detect(self, frame: Frame, level: str, labels: Iterable[str]) -> list[Detection]:

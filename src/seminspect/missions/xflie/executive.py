@@ -105,6 +105,7 @@ class XFlie:
             lidar_every_m=config.exploration.lidar_every_m,
             camera_every_m=config.exploration.camera_every_m,
             clear_misses_to=self.params.d_max,
+            carving_spacing=config.map_carving_spacing,
             timers=self.recorder.timers,
             charge_planning_time=config.charge_planning_time,
         )

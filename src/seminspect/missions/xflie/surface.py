@@ -34,11 +34,12 @@ MIN_VIEW_STEP = 0.1
 
 
 class PointSet:
-    """Points thinned to one per voxel, with radius queries."""
+    """Points thinned to one per voxel (the first seen in it), with radius queries."""
 
     def __init__(self, voxel: float) -> None:
         self.voxel = voxel
         self.points: NDArray[np.float64] = np.empty((0, 3))
+        self._voxels: set[tuple[int, ...]] = set()
         self._tree: cKDTree | None = None
 
     @property
@@ -46,12 +47,19 @@ class PointSet:
         return len(self.points)
 
     def add(self, points: NDArray[np.float64]) -> None:
-        merged = np.vstack([self.points, points])
-        _, first = np.unique(
-            np.floor(merged / self.voxel).astype(np.int64), axis=0, return_index=True
-        )
-        self.points = merged[np.sort(first)]
-        self._tree = None
+        """Keep each point whose voxel holds none yet, in order. Only the new points are
+        sorted: deduplicating the whole, growing set on every view cost seconds a mission."""
+        cells = np.floor(points / self.voxel).astype(np.int64)
+        _, first = np.unique(cells, axis=0, return_index=True)
+        fresh = []
+        for index in np.sort(first).tolist():
+            cell = tuple(cells[index].tolist())
+            if cell not in self._voxels:
+                self._voxels.add(cell)
+                fresh.append(index)
+        if fresh:
+            self.points = np.vstack([self.points, points[fresh]])
+            self._tree = None
 
     def near(self, points: NDArray[np.float64], radius: float) -> NDArray[np.bool_]:
         """Which ``points`` lie within ``radius`` of the set."""
