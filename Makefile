@@ -29,6 +29,7 @@ $(VENV)/.installed-test: pyproject.toml $(LOCK) | $(BIN)/python
 # runs starts warm: the compilation (tens of seconds) moves from that mission to the install.
 WARM_UP_RUN := $(VENV)/warm-up-run
 $(VENV)/.compiled: $(VENV)/.installed-run
+	@echo 'Compiling the kernels with one short mission (a minute or two, once per install)...'
 	rm -rf $(WARM_UP_RUN)
 	$(BIN)/seminspect mission --world city --scenario small --budget 300 --no-pictures \
 		--out $(WARM_UP_RUN) > /dev/null
