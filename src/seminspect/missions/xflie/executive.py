@@ -107,6 +107,7 @@ class XFlie:
             clear_misses_to=self.params.d_max,
             timers=self.recorder.timers,
             charge_planning_time=config.charge_planning_time,
+            guard_unknown=config.mode == "aerial",
         )
         self.ctx = MissionContext(
             config,

@@ -146,8 +146,12 @@ class LevelInspection:
             return False
         here = ctx.platform.position
         goal = here + np.array([0.0, 0.0, self.view.vertical_step])
+        if not ctx.navigator.segment_is_free(here, goal):
+            ctx.event("climb-blocked", target=target.id, height=round(float(goal[2]), 2))
+            return False
         with ctx.timers("driving"):
             motion = ctx.platform.move_to(goal, ctx.platform.yaw)
+        ctx.navigator.sense_lidar()
         if not motion.reached:
             return False
         with ctx.timers("graph"):
