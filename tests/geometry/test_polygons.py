@@ -1,7 +1,12 @@
 import numpy as np
 import pytest
 
-from seminspect.geometry.polygons import polygon_centroid, polygon_contains, ring_polygon
+from seminspect.geometry.polygons import (
+    hull_polygon,
+    polygon_centroid,
+    polygon_contains,
+    ring_polygon,
+)
 
 SQUARE = [[0, 0], [4, 0], [4, 2], [0, 2]]
 
@@ -33,3 +38,12 @@ def test_repeated_points_and_a_closed_ring_are_tolerated() -> None:
 def test_point_in_polygon_excludes_the_boundary() -> None:
     inside = polygon_contains(SQUARE, [[1, 1], [5, 1], [4, 1], [2, 0.001]])
     assert inside.tolist() == [True, False, False, True]
+
+
+def test_the_hull_of_scattered_points_holds_them_all() -> None:
+    rng = np.random.default_rng(3)
+    points = rng.uniform(-5, 5, size=(40, 2))
+    hull = hull_polygon(points)
+    assert hull is not None and 3 <= len(hull) <= 40
+    assert polygon_contains(hull, points * 0.999).all()
+    assert hull_polygon([[0, 0], [1, 1], [2, 2]]) is None

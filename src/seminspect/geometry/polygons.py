@@ -37,6 +37,13 @@ def ring_polygon(points_xy: ArrayLike) -> NDArray[np.float64] | None:
     ring = shapely.Polygon(pts)
     if ring.is_valid and ring.area > 0:
         return pts
+    return hull_polygon(pts)
+
+
+def hull_polygon(points_xy: ArrayLike) -> NDArray[np.float64] | None:
+    """The convex hull of ``points_xy`` (K x 2) as polygon vertices, or ``None`` when it has
+    no area (fewer than three points, or all on a line)."""
+    pts = np.asarray(points_xy, dtype=np.float64).reshape(-1, 2)
     hull = shapely.MultiPoint(pts).convex_hull
     if isinstance(hull, shapely.Polygon) and hull.area > 0:
         return np.asarray(hull.exterior.coords, dtype=np.float64)[:-1]
