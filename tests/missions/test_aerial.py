@@ -60,3 +60,13 @@ def test_windows_and_rubble_on_the_building_answer_queries(aerial_mission) -> No
     level = next(lv for lv in building.levels if any(p.id == window.pose_id for p in lv.poses))
     plan = HierarchicalPlanner(graph).query(f"Visit {window.name} in {level.name} of {building.id}")
     assert window.id in (plan.goal_id, plan.terminal_id) and len(plan.waypoints) >= 2
+
+
+def test_the_buildings_surface_coverage_is_reported_on_its_own(aerial_mission) -> None:
+    t6 = aerial_mission.metrics.table6
+    (building,) = aerial_mission.mission.graph.targets()
+    assert set(t6.surface_coverage_by_target_pct) == {building.id}
+    assert t6.surface_coverage_by_target_pct[building.id] == pytest.approx(t6.surface_coverage_pct)
+    assert 0 < t6.surface_coverage_pct <= 100
+    summary = (aerial_mission.run_dir / "summary.md").read_text()
+    assert f"| {t6.surface_coverage_pct:.1f} |" in summary.split("## Targets")[1]

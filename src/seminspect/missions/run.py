@@ -251,12 +251,13 @@ def quality_figures(
     (surface coverage and the paper's bounding-box volume)."""
     by_name = {info.name: info for info in world.instances.values()}
     coverage = mission.recorder.coverage
-    surface, box, truth_box = [], 0.0, 0.0
+    surface: dict[str, float] = {}
+    box, truth_box = 0.0, 0.0
     for match in score.matches:
         if not match.inspected:
             continue
         info = by_name[match.truth]
-        surface.append(coverage.surface_coverage(match.target_id, world, info.id))
+        surface[match.target_id] = coverage.surface_coverage(match.target_id, world, info.id)
         box += coverage.targets[match.target_id].box_volume
         truth_box += float(np.prod(info.bbox_max - info.bbox_min))
     return QualityFigures(
@@ -264,10 +265,11 @@ def quality_figures(
         planning_load_pct(mission),
         _finite(score.rmse(horizontal=True)),
         _finite(score.rmse(horizontal=False)),
-        100.0 * float(np.mean(surface)) if surface else None,
+        100.0 * float(np.mean(list(surface.values()))) if surface else None,
         box,
         truth_box,
         box / truth_box if truth_box else None,
+        {target_id: 100.0 * share for target_id, share in surface.items()},
     )
 
 
