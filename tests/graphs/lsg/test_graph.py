@@ -277,11 +277,11 @@ def test_nodes_built_by_hand_get_the_edges_of_their_layer() -> None:
         )
 
 
-def test_a_polygon_grown_with_what_was_seen_covers_a_building_circled_in_part() -> None:
+def test_a_polygon_grown_from_every_level_covers_a_building_circled_in_part() -> None:
     """A 20 x 10 m building centred at (10, 0): Level-0 circled only its west half, Level-1
-    its east half, and the camera saw its whole footprint."""
+    its east half."""
 
-    def inspected(seen):
+    def inspected(every_level):
         graph = LayeredSemanticGraph()
         graph.register_target(Observation([4, 0, 3], label="building", score=1, mask_area=1))
         graph.optimise_targets()
@@ -291,12 +291,11 @@ def test_a_polygon_grown_with_what_was_seen_covers_a_building_circled_in_part() 
         graph.begin_level(Observation.view_pose([24, 0, 5]))
         for x, y in ((15, -9), (24, -9), (24, 9), (15, 9)):
             graph.register_pose(Observation.view_pose([x, y, 5]))
-        return graph, graph.finish_inspection(seen=seen)
+        return graph, graph.finish_inspection(every_level=every_level)
 
-    corners = [[0, -5, 1], [20, -5, 1], [20, 5, 1], [0, 5, 1]]
-    _, first_ring_only = inspected(seen=None)
+    _, first_ring_only = inspected(every_level=False)
     assert first_ring_only.position[0] < 1.0  # Level-0's ring: the west half only
-    graph, building = inspected(seen=corners)
+    graph, building = inspected(every_level=True)
     np.testing.assert_allclose(building.position[:2], [10.0, 0.0], atol=1e-9)
     # a far-side detection now falls inside the polygon and is not a new target
     graph.update_robot([28, 0, 2], quat_from_yaw(math.pi), 1.0)

@@ -488,9 +488,7 @@ class LayeredSemanticGraph:
         )
         return self.add_feature(feature)
 
-    def finish_inspection(
-        self, polygon_level: int = 0, seen: ArrayLike | None = None
-    ) -> TargetNode:
+    def finish_inspection(self, polygon_level: int = 0, every_level: bool = False) -> TargetNode:
         """Close the last level, build the containment polygon and mark the target inspected.
 
         The polygon's vertices are the pose nodes of the first level (000 Sec V-B), or of level
@@ -501,10 +499,9 @@ class LayeredSemanticGraph:
         position, are re-detections of this target and are removed (000 Fig 17f);
         :attr:`pruned` lists them.
 
-        ``seen`` (``(n, 2)`` or ``(n, 3)`` points of the target) makes the polygon grow with what
-        was seen: it becomes the convex hull of every level's poses and those points. A structure
-        much larger than the camera's footprint may be circled only in part at some level, and
-        one level's ring then covers only part of it.
+        With ``every_level`` the polygon grows with what was seen: it is the convex hull of every
+        level's poses. A structure much larger than the camera's footprint may be circled only
+        in part at some level, and one level's ring then covers only part of it.
         """
         inspection = self._require_inspection()
         self.close_level()
@@ -512,13 +509,10 @@ class LayeredSemanticGraph:
         levels = target.levels
         if not 0 <= polygon_level < len(levels):
             raise InvalidInputError(f"{target.id} has no level {polygon_level}")
-        if seen is None:
-            polygon = ring_polygon([p.position[:2] for p in levels[polygon_level].poses])
+        if every_level:
+            polygon = hull_polygon([p.position[:2] for level in levels for p in level.poses])
         else:
-            polygon = hull_polygon(
-                [p.position[:2] for level in levels for p in level.poses]
-                + list(np.asarray(seen, dtype=np.float64).reshape(len(seen), -1)[:, :2])
-            )
+            polygon = ring_polygon([p.position[:2] for p in levels[polygon_level].poses])
         if polygon is not None:
             target.polygon = polygon
             centre = polygon_centroid(polygon)

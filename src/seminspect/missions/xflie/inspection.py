@@ -76,10 +76,11 @@ class LevelInspection:
             return False
         closed = [i for i, done in enumerate(self.closed_levels) if done]
         # Aerial robots circle structures much larger than the camera's footprint, each level
-        # perhaps in part: their polygon grows with every level and everything seen of it.
-        seen = self.tracker.target_cloud.points if ctx.config.mode == "aerial" else None
+        # perhaps in part: their polygon grows with every level.
         with ctx.timers("graph"):
-            ctx.graph.finish_inspection(polygon_level=closed[0] if closed else 0, seen=seen)
+            ctx.graph.finish_inspection(
+                polygon_level=closed[0] if closed else 0, every_level=ctx.config.mode == "aerial"
+            )
         for pruned in ctx.graph.pruned:
             ctx.event("discarded", target=pruned, reason=f"re-detection of {target.id}")
         return True
