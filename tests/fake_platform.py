@@ -143,15 +143,17 @@ def fake_context(
     *,
     settings: dict[str, Any] | None = None,
     size: float = 20.0,
+    height: float = 3.0,
     known_free: bool = True,
 ) -> tuple[MissionContext, EventList]:
-    """A context on a fake platform in a ``size`` x ``size`` m map (free, or unknown)."""
+    """A context on a fake platform in a ``size`` x ``size`` x ``height`` m map (free, or
+    unknown)."""
     platform = platform or FakePlatform()
     config: ResolvedMissionConfig = resolve(
         make_config({"world": "campus", "time_budget_s": 600.0} | (settings or {}))
     )
     half = size / 2
-    occupancy = VoxelMap.empty([-half, -half, -0.25], [half, half, 2.75], 0.5)
+    occupancy = VoxelMap.empty([-half, -half, -0.25], [half, half, height - 0.25], 0.5)
     if known_free:
         occupancy.states[:] = FREE
     graph = LayeredSemanticGraph(config.params, robot_position=platform.position)
@@ -168,6 +170,7 @@ def fake_context(
         camera_every_m=4.0,
         clear_misses_to=5.0,
         timers=recorder.timers,
+        guard_unknown=config.mode == "aerial",
     )
     ctx = MissionContext(
         config, platform, occupancy, graph, navigator, recorder, None, min_height=0.15

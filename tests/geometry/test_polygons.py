@@ -1,7 +1,13 @@
 import numpy as np
 import pytest
 
-from seminspect.geometry.polygons import polygon_centroid, polygon_contains, ring_polygon
+from seminspect.geometry.polygons import (
+    hull_polygon,
+    polygon_centroid,
+    polygon_contains,
+    polygon_meets_sector,
+    ring_polygon,
+)
 
 SQUARE = [[0, 0], [4, 0], [4, 2], [0, 2]]
 
@@ -33,3 +39,21 @@ def test_repeated_points_and_a_closed_ring_are_tolerated() -> None:
 def test_point_in_polygon_excludes_the_boundary() -> None:
     inside = polygon_contains(SQUARE, [[1, 1], [5, 1], [4, 1], [2, 0.001]])
     assert inside.tolist() == [True, False, False, True]
+
+
+def test_the_hull_of_scattered_points_holds_them_all() -> None:
+    rng = np.random.default_rng(3)
+    points = rng.uniform(-5, 5, size=(40, 2))
+    hull = hull_polygon(points)
+    assert hull is not None and 3 <= len(hull) <= 40
+    assert polygon_contains(hull, points * 0.999).all()
+    assert hull_polygon([[0, 0], [1, 1], [2, 2]]) is None
+
+
+def test_a_sector_meets_a_polygon_only_within_its_angle_and_radius() -> None:
+    wall = [[-10, 2], [10, 2], [10, 3], [-10, 3]]  # a long wall 2 m north of the origin
+    north, south = np.pi / 2, -np.pi / 2
+    assert polygon_meets_sector(wall, (0, 0), north, np.radians(30), 5.0)
+    assert not polygon_meets_sector(wall, (0, 0), south, np.radians(30), 5.0)
+    assert not polygon_meets_sector(wall, (0, 0), north, np.radians(30), 1.5)  # out of reach
+    assert polygon_meets_sector(wall, (0, 2.5), south, np.radians(10), 0.1)  # standing inside

@@ -24,6 +24,17 @@ def test_collapsed_buildings_have_features_levels_and_a_free_ring(scenario) -> N
     assert world.is_free(points, 0.4, "ground").all()
 
 
+def test_small_collapsed_site_holds_one_collapsed_building_with_every_feature() -> None:
+    world = generate_world("collapsed-buildings", "small")
+    (building,) = world.instances_of("building")
+    assert {"window", "person", "rubble", "wall", "roof"} <= set(building.parts)
+    assert building.height >= 2 * STOREY - 0.1
+    low, high = world.bounds
+    assert (building.bbox_min[:2] > low[:2] + 8.0).all()  # room to fly around it
+    assert (building.bbox_max[:2] < high[:2] - 8.0).all()
+    assert (high - low)[0] < generate_world("collapsed-buildings", "fire-station").bounds[1][0]
+
+
 def test_subterranean_is_the_papers_tunnel_with_one_car() -> None:
     world = generate_world("subterranean")
     np.testing.assert_allclose(world.bounds[1] - world.bounds[0], [10, 6, 4])

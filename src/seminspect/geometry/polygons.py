@@ -10,6 +10,10 @@ from numpy.typing import ArrayLike, NDArray
 _VERTEX_TOLERANCE = 1e-6
 
 
+#: Points on the arc of a sector tested by :func:`polygon_meets_sector`.
+SECTOR_ARC_POINTS = 17
+
+
 def _drop_repeats(points: NDArray[np.float64]) -> NDArray[np.float64]:
     keep = [0]
     for i in range(1, len(points)):
@@ -37,6 +41,13 @@ def ring_polygon(points_xy: ArrayLike) -> NDArray[np.float64] | None:
     ring = shapely.Polygon(pts)
     if ring.is_valid and ring.area > 0:
         return pts
+    return hull_polygon(pts)
+
+
+def hull_polygon(points_xy: ArrayLike) -> NDArray[np.float64] | None:
+    """The convex hull of ``points_xy`` (K x 2) as polygon vertices, or ``None`` when it has
+    no area (fewer than three points, or all on a line)."""
+    pts = np.asarray(points_xy, dtype=np.float64).reshape(-1, 2)
     hull = shapely.MultiPoint(pts).convex_hull
     if isinstance(hull, shapely.Polygon) and hull.area > 0:
         return np.asarray(hull.exterior.coords, dtype=np.float64)[:-1]
@@ -54,3 +65,15 @@ def polygon_contains(vertices: ArrayLike, points_xy: ArrayLike) -> NDArray[np.bo
     polygon = shapely.Polygon(np.asarray(vertices, dtype=np.float64))
     pts = np.asarray(points_xy, dtype=np.float64).reshape(-1, 2)
     return shapely.contains_xy(polygon, pts[:, 0], pts[:, 1])
+
+
+def polygon_meets_sector(
+    vertices: ArrayLike, apex: ArrayLike, heading: float, half_angle: float, radius: float
+) -> bool:
+    """Whether a polygon (K x 2) overlaps the circular sector seen from ``apex`` (x, y, ...)
+    along ``heading`` within ``half_angle`` either side, out to ``radius`` [m, rad]."""
+    x, y = np.asarray(apex, dtype=np.float64)[:2]
+    angles = heading + np.linspace(-half_angle, half_angle, SECTOR_ARC_POINTS)
+    arc = np.column_stack([x + radius * np.cos(angles), y + radius * np.sin(angles)])
+    sector = shapely.Polygon(np.vstack([[x, y], arc]))
+    return bool(sector.intersects(shapely.Polygon(np.asarray(vertices, dtype=np.float64))))

@@ -175,6 +175,8 @@ class QualityFigures:
     bbox_volume_m3: float
     true_bbox_volume_m3: float
     bbox_volume_ratio: float | None
+    #: Surface coverage of each inspected target that matched a true object, by target id.
+    surface_coverage_by_target_pct: dict[str, float] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from seminspect.core.errors import PlanningError
-from seminspect.mapping.voxel import OCCUPIED, VoxelMap
+from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap
 from seminspect.missions.metrics import Timers
 from seminspect.missions.platform import Platform
 from seminspect.planning.grid_search import GridPath
@@ -70,6 +70,11 @@ class Navigator:
             None carves along every beam.
         timers: where sensing, planning and driving time is charged.
         charge_planning_time: the robot waits for each route's planning wall time.
+        guard_unknown: moves kept to known space (``known_only``) also keep the planner's
+            clearance from unknown cells below the robot, as from occupied ones. An aerial robot
+            needs this: its LiDAR sees nothing below it, and what it has not seen there (a slab,
+            rubble) is what it would fly into. Space above it stays as mapped: the robot climbs
+            only along a face it is looking at.
     """
 
     def __init__(
@@ -85,8 +90,10 @@ class Navigator:
         carving_spacing: float | None = None,
         timers: Timers | None = None,
         charge_planning_time: bool = False,
+        guard_unknown: bool = False,
     ) -> None:
         self.timers = timers or Timers()
+        self.guard_unknown = guard_unknown
         self.platform = platform
         self.charge_planning_time = charge_planning_time
         self.occupancy = occupancy
@@ -117,7 +124,38 @@ class Navigator:
                 clear_misses_to=self.clear_misses_to,
                 carving_spacing=self.carving_spacing,
             )
+            if self.guard_unknown:
+                self._clear_body()
         return self.last_scan
+
+    def _clear_body(self) -> None:
+        """Mark the unknown cells within the planner's clearance of the robot free: its body
+        is there, and it came there by moves that kept this clearance."""
+        voxel_map = self.occupancy
+        reach = self.planner.model.robot_radius
+        here = self.platform.position
+        lo = np.maximum(voxel_map.world_to_index(here - reach), 0)
+        hi = np.minimum(voxel_map.world_to_index(here + reach) + 1, voxel_map.shape)
+        block = tuple(slice(a, b) for a, b in zip(lo, hi, strict=True))
+        cells = np.stack(
+            np.meshgrid(*(np.arange(a, b) for a, b in zip(lo, hi, strict=True)), indexing="ij"),
+            axis=-1,
+        )
+        near = np.linalg.norm(voxel_map.index_to_world(cells) - here, axis=-1) <= reach
+        states = voxel_map.states[block]
+        states[near & (states == UNKNOWN)] = FREE
+
+    def guarded_map(self) -> VoxelMap:
+        """The map as moves in known space see it: unknown cells below the robot count as
+        occupied when :attr:`guard_unknown` is set (see the class docstring)."""
+        if not self.guard_unknown:
+            return self.occupancy
+        voxel_map = self.occupancy
+        below = voxel_map.world_to_index(self.platform.position)[2]
+        guarded = voxel_map.states.copy()
+        lower = guarded[:, :, : max(below, 0)]
+        lower[lower == UNKNOWN] = OCCUPIED
+        return VoxelMap(voxel_map.origin, voxel_map.resolution, guarded)
 
     def mark_contact(self, contact: NDArray[np.float64] | None) -> None:
         """Write a felt obstacle into the map, so that no route tries it again."""
@@ -130,7 +168,8 @@ class Navigator:
     def cost_grid(self, known_only: bool = False) -> CostGrid:
         """The planner's grid on the map as it is now (costs filled as they are asked for)."""
         planner = self.known_planner if known_only else self.planner
-        return CostGrid.build(self.occupancy, planner.model, planner.band, lazy=True)
+        voxel_map = self.guarded_map() if known_only else self.occupancy
+        return CostGrid.build(voxel_map, planner.model, planner.band, lazy=True)
 
     def segment_is_free(
         self, a: ArrayLike, b: ArrayLike, grid: CostGrid | None = None, known_only: bool = False
@@ -218,7 +257,8 @@ class Navigator:
             started = time.perf_counter()
             try:
                 with self.timers("planning"):
-                    path = planner.plan(self.occupancy, self.platform.position, goal_point, radius)
+                    voxel_map = self.guarded_map() if known_only else self.occupancy
+                    path = planner.plan(voxel_map, self.platform.position, goal_point, radius)
             except PlanningError:
                 self.stats.local_failures += 1
                 self.planned(time.perf_counter() - started)

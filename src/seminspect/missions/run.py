@@ -257,10 +257,11 @@ def quality_figures(
     by_name = {info.name: info for info in world.instances.values()}
     coverage = mission.recorder.coverage
     scored = scored_matches(score.matches, inspects(mission.config.planner))
-    surface, box, truth_box = [], 0.0, 0.0
+    surface: dict[str, float] = {}
+    box, truth_box = 0.0, 0.0
     for match in scored:
         info = by_name[match.truth]
-        surface.append(coverage.surface_coverage(match.target_id, world, info.id))
+        surface[match.target_id] = coverage.surface_coverage(match.target_id, world, info.id)
         box += coverage.targets[match.target_id].box_volume
         truth_box += float(np.prod(info.bbox_max - info.bbox_min))
     return QualityFigures(
@@ -268,10 +269,11 @@ def quality_figures(
         planning_load_pct(mission),
         _finite(localisation_rmse(scored, horizontal=True)),
         _finite(localisation_rmse(scored, horizontal=False)),
-        100.0 * float(np.mean(surface)) if surface else None,
+        100.0 * float(np.mean(list(surface.values()))) if surface else None,
         box,
         truth_box,
         box / truth_box if truth_box else None,
+        {target_id: 100.0 * share for target_id, share in surface.items()},
     )
 
 

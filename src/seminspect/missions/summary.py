@@ -104,13 +104,14 @@ def summary_markdown(
         "",
         "## Targets",
         "",
-        "| Target | Status | Levels | Poses | Features |",
-        "|---|---|---|---|---|",
+        "| Target | Status | Levels | Poses | Features | Surface coverage (%) |",
+        "|---|---|---|---|---|---|",
     ]
+    coverage = t6.surface_coverage_by_target_pct
     for t in graph.targets():
         poses = [p for lv in t.levels for p in lv.poses]
         lines.append(
             f"| {t.id} | {t.status.value} | {len(t.levels)} | {len(poses)} | "
-            f"{sum(len(p.features) for p in poses)} |"
+            f"{sum(len(p.features) for p in poses)} | {_fmt(coverage.get(t.id), 1)} |"
         )
     return "\n".join(lines) + "\n"

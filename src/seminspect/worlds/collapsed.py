@@ -1,12 +1,13 @@
 """Collapsed multi-storey buildings with windows, people and rubble (000 Sec VI-B, Table 2).
 
-Two scenarios, as in 000 Sec VI-B: a collapsed two-storey fire station and a collapsed
-three-storey industrial building, each next to a smaller intact annex. Each building is one
-``building`` object whose faces carry the parts ``wall``, ``roof``, ``window``, ``rubble`` and
-``person``. One end of the main building has come down: its upper storeys are gone, a floor slab
-leans into the gap and rubble and casualties lie within 2 m of the walls, which leaves a ring at
-3 m from the building free for a ground robot. Storeys are 3.5 m high, so each building offers
-at least two inspection levels.
+Two scenarios, as in 000 Sec VI-B: a collapsed two-storey fire station and a collapsed three-
+storey industrial building, each next to a smaller intact annex; and a ``small`` one, a single
+collapsed two-storey building on a smaller site, for quick checks and tests. Each building is
+one ``building`` object whose faces carry the parts ``wall``, ``roof``, ``window``, ``rubble``
+and ``person``. One end of the main building has come down: its upper storeys are gone, a floor
+slab leans into the gap and rubble and casualties lie within 2 m of the walls, which leaves a
+ring at 3 m from the building free for a ground robot. Storeys are 3.5 m high, so each building
+offers at least two inspection levels.
 """
 
 from __future__ import annotations
@@ -22,6 +23,8 @@ from seminspect.worlds.shapes import Piece, box, pose_matrix
 from seminspect.worlds.world import World
 
 SIZE = (80.0, 56.0, 14.0)
+#: Scenarios on a site of another size than ``SIZE``.
+SITE_SIZES = {"small": (36.0, 30.0, 10.0)}
 STOREY = 3.5
 START = (4.0, 4.0, 0.0)
 #: Rubble and people stay this close to the walls (metres).
@@ -39,7 +42,7 @@ class _Building:
     people: int = 0
 
 
-SCENARIOS: dict[str, tuple[_Building, _Building]] = {
+SCENARIOS: dict[str, tuple[_Building, ...]] = {
     "fire-station": (
         _Building((12.0, 14.0), 24.0, 14.0, 2, collapsed=True, rubble=40, people=2),
         _Building((52.0, 20.0), 10.0, 8.0, 2, collapsed=False),
@@ -48,6 +51,7 @@ SCENARIOS: dict[str, tuple[_Building, _Building]] = {
         _Building((12.0, 14.0), 36.0, 20.0, 3, collapsed=True, rubble=70, people=3),
         _Building((62.0, 20.0), 12.0, 10.0, 2, collapsed=False),
     ),
+    "small": (_Building((12.0, 11.0), 12.0, 8.0, 2, collapsed=True, rubble=12, people=1),),
 }
 
 
@@ -130,14 +134,15 @@ def _building_pieces(spec: _Building, rng: np.random.Generator) -> list[Piece]:
 
 
 def generate_collapsed(scenario: str, seed: int) -> World:
-    """Build the ``fire-station`` or ``industrial`` scenario."""
+    """Build the ``fire-station``, ``industrial`` or ``small`` scenario."""
     rng = make_rng(seed, "worlds", "collapsed-buildings", scenario)
+    size = SITE_SIZES.get(scenario, SIZE)
     builder = WorldBuilder("collapsed-buildings", seed)
-    builder.add_ground((0.0, 0.0), SIZE[:2])
+    builder.add_ground((0.0, 0.0), size[:2])
     for spec in SCENARIOS[scenario]:
         builder.add_object(_building_pieces(spec, rng), "building")
     return builder.build(
-        bounds=[(0.0, 0.0, 0.0), SIZE],
+        bounds=[(0.0, 0.0, 0.0), size],
         start_position=START,
         start_yaw=0.0,
         metadata={"ground_z": 0.0, "storey_height": STOREY},

@@ -275,3 +275,31 @@ def test_nodes_built_by_hand_get_the_edges_of_their_layer() -> None:
         graph.add_feature(
             FeatureNode("car-0/trunk-1", "trunk-1", "trunk", level.id, np.ones(3), 0.9, 10, None)
         )
+
+
+def test_a_polygon_grown_from_every_level_covers_a_building_circled_in_part() -> None:
+    """A 20 x 10 m building centred at (10, 0): Level-0 circled only its west half, Level-1
+    its east half."""
+
+    def inspected(every_level):
+        graph = LayeredSemanticGraph()
+        graph.register_target(Observation([4, 0, 3], label="building", score=1, mask_area=1))
+        graph.optimise_targets()
+        graph.begin_inspection("building-0", Observation.view_pose([-4, 0, 2]))
+        for x, y in ((-4, -9), (5, -9), (5, 9), (-4, 9)):
+            graph.register_pose(Observation.view_pose([x, y, 2]))
+        graph.begin_level(Observation.view_pose([24, 0, 5]))
+        for x, y in ((15, -9), (24, -9), (24, 9), (15, 9)):
+            graph.register_pose(Observation.view_pose([x, y, 5]))
+        return graph, graph.finish_inspection(every_level=every_level)
+
+    _, first_ring_only = inspected(every_level=False)
+    assert first_ring_only.position[0] < 1.0  # Level-0's ring: the west half only
+    graph, building = inspected(every_level=True)
+    np.testing.assert_allclose(building.position[:2], [10.0, 0.0], atol=1e-9)
+    # a far-side detection now falls inside the polygon and is not a new target
+    graph.update_robot([28, 0, 2], quat_from_yaw(math.pi), 1.0)
+    graph.register_target(Observation([19, 1, 3], label="building", score=1, mask_area=9))
+    update = graph.optimise_targets()
+    assert update.decisions[0].outcome is Outcome.INSIDE_POLYGON
+    assert len(graph.targets()) == 1

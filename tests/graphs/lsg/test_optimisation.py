@@ -85,6 +85,36 @@ def test_a_long_target_is_in_view_when_part_of_its_polygon_is() -> None:
     )
 
 
+#: A building 200 m long and 30 m deep, centred at (0, 17): corners far off to the sides.
+LONG_BUILDING = InspectedView(
+    "building-0",
+    np.array([0.0, 17.0, 0.0]),
+    np.array([[-100, 2], [100, 2], [100, 32], [-100, 32.0]]),
+)
+
+
+@pytest.mark.parametrize(
+    ("robot", "yaw"),
+    [((30.0, 0.0, 4.0), math.pi / 2), ((30.0, 15.0, 10.0), -math.pi / 2)],
+    ids=["facing-its-wall", "above-it"],
+)
+def test_a_building_is_in_view_when_its_wall_fills_the_image(robot, yaw) -> None:
+    """Centre and every corner out of view: the robot faces the building's wall from 2 m, or
+    flies above it (inside its polygon) looking down its length."""
+
+    def in_view(position, heading):
+        return inspected_in_view(
+            [LONG_BUILDING],
+            robot_position=np.array(position),
+            robot_yaw=heading,
+            d_max=30.0,
+            fov_rad=FOV,
+        )
+
+    assert [v.target_id for v in in_view(robot, yaw)] == ["building-0"]
+    assert in_view((30.0, 0.0, 4.0), -math.pi / 2) == []  # outside it, facing away
+
+
 def test_view_set_uses_range_and_half_fov() -> None:
     far = InspectedView("far", np.array([40.0, 0.0, 0.0]), None)
     side = InspectedView("side", np.array([10.0, 7.5, 0.0]), None)  # 36.9 deg off axis

@@ -5,9 +5,11 @@ import numpy as np
 from fake_platform import fake_context, headings_apart
 from seminspect.missions.xflie.approach import (
     ARRIVAL_FALLBACKS,
+    PLANNING_MARGIN,
     Approach,
     baseline_planner,
     local_planner,
+    planning_clearance,
 )
 from seminspect.perception.observation import Observation
 from seminspect.planning.hierarchical import HierarchicalPlanner
@@ -63,3 +65,11 @@ def test_the_planners_follow_the_configuration() -> None:
     assert isinstance(baseline_planner(ctx.config), RebuildingVolumetricPlanner)
     hierarchical, _ = fake_context()
     assert baseline_planner(hierarchical.config) is None
+
+
+def test_aerial_robots_keep_a_wider_berth_than_ground_robots() -> None:
+    ground, _ = fake_context()
+    aerial, _ = fake_context(settings={"mode": "aerial"})
+    assert planning_clearance(ground.config) == ground.config.robot.radius + PLANNING_MARGIN
+    assert planning_clearance(aerial.config) > planning_clearance(ground.config)
+    assert local_planner(aerial.config).model.robot_radius == planning_clearance(aerial.config)

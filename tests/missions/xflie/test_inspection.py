@@ -2,13 +2,14 @@ import numpy as np
 
 from fake_platform import FakePlatform, fake_context
 from seminspect.graphs.lsg.model import TargetStatus
+from seminspect.mapping.voxel import OCCUPIED
 from seminspect.missions.xflie.inspection import LevelInspection, dilate, platform_vfov
 from seminspect.perception.observation import Observation
 from seminspect.planning.view_planner import ViewConstraints
 
 
-def inspection_of_a_car(platform=None, settings=None):
-    ctx, events = fake_context(platform or FakePlatform(), settings=settings)
+def inspection_of_a_car(platform=None, settings=None, height=3.0):
+    ctx, events = fake_context(platform or FakePlatform(), settings=settings, height=height)
     ctx.graph.register_target(Observation([3.5, 0.0, 0.7], label="car", score=0.9, mask_area=1))
     ctx.graph.optimise_targets()
     view = ViewConstraints(
@@ -45,7 +46,9 @@ def test_an_inspection_with_too_few_views_is_cancelled() -> None:
 
 def test_an_aerial_robot_climbs_only_while_the_target_rises_above_its_view() -> None:
     platform = FakePlatform(position=(1.0, 0.0, 2.0))
-    ctx, events, inspection, car = inspection_of_a_car(platform, settings={"mode": "aerial"})
+    ctx, events, inspection, car = inspection_of_a_car(
+        platform, settings={"mode": "aerial"}, height=8.0
+    )
     with ctx.timers("graph"):
         ctx.graph.begin_inspection(car.id, ctx.view_pose(image=None))
     assert not inspection.climb(car, heights=[2.5])  # the view already reaches the top
@@ -53,6 +56,19 @@ def test_an_aerial_robot_climbs_only_while_the_target_rises_above_its_view() -> 
     assert inspection.climb(car, heights=[12.0])
     assert platform.position[2] == 2.0 + inspection.view.vertical_step
     assert events.kinds()[-1] == "level" and len(car.levels) == 2
+
+
+def test_an_aerial_robot_does_not_climb_into_structure_it_has_mapped_above_it() -> None:
+    platform = FakePlatform(position=(1.0, 0.0, 2.0))
+    ctx, events, inspection, car = inspection_of_a_car(
+        platform, settings={"mode": "aerial"}, height=8.0
+    )
+    ctx.occupancy.states[:, :, ctx.occupancy.world_to_index([0, 0, 3.5])[2]] = OCCUPIED  # a slab
+    with ctx.timers("graph"):
+        ctx.graph.begin_inspection(car.id, ctx.view_pose(image=None))
+    assert not inspection.climb(car, heights=[12.0])
+    assert platform.position[2] == 2.0 and platform.distance_travelled == 0.0
+    assert events.kinds()[-1] == "climb-blocked" and len(car.levels) == 1
 
 
 def test_a_mask_grows_by_four_connected_steps() -> None:

@@ -1,14 +1,21 @@
 import numpy as np
 
 from fake_platform import FakePlatform, fake_context
+from seminspect.mapping.voxel import OCCUPIED
 from seminspect.missions.xflie.inspection import platform_vfov
-from seminspect.missions.xflie.surface import ATTACHED, MIN_VIEW_STEP, PointSet, SurfaceTracker
+from seminspect.missions.xflie.surface import (
+    ATTACHED,
+    MAPPED_REACH,
+    MIN_VIEW_STEP,
+    PointSet,
+    SurfaceTracker,
+)
 from seminspect.perception.observation import Observation
 from seminspect.planning.view_planner import ViewConstraints
 
 
-def tracker(platform: FakePlatform | None = None) -> SurfaceTracker:
-    ctx, _ = fake_context(platform)
+def tracker(platform: FakePlatform | None = None, settings=None) -> SurfaceTracker:
+    ctx, _ = fake_context(platform, settings=settings)
     view = ViewConstraints(
         d_view=2.5,
         overlap_h=0.6,
@@ -91,3 +98,24 @@ def test_a_view_move_too_short_to_matter_is_refused() -> None:
     goal = platform.position + np.array([MIN_VIEW_STEP / 2, 0.0, 0.0])
     assert not track.move_to_view(goal, 0.0)
     assert platform.distance_travelled == 0.0
+
+
+def mapped_around(mode: str) -> tuple[SurfaceTracker, np.ndarray]:
+    """A robot at (0, 0, 2) whose map holds the ground, a slab stub 1.5 m beside it below its
+    camera's view, and a wall beyond the mapped reach."""
+    track = tracker(FakePlatform(position=(0.0, 0.0, 2.0)), settings={"mode": mode})
+    occupancy = track.ctx.occupancy
+    occupancy.states[:, :, 0] = OCCUPIED  # the ground, -0.25 to 0.25 m
+    stub = occupancy.world_to_index([1.5, 0.0, 1.0])
+    occupancy.states[tuple(stub)] = OCCUPIED
+    far = occupancy.world_to_index([MAPPED_REACH * track.view.d_view + 1.0, 0.0, 1.0])
+    occupancy.states[tuple(far)] = OCCUPIED
+    return track, occupancy.index_to_world(stub)
+
+
+def test_an_aerial_robot_keeps_its_distance_from_mapped_structure_below_its_view() -> None:
+    track, stub = mapped_around("aerial")
+    surface = track.surface(np.empty((0, 3)))
+    np.testing.assert_allclose(surface, [stub])  # neither the ground nor the far wall
+    ground, _ = mapped_around("ground")
+    assert len(ground.surface(np.empty((0, 3)))) == 0  # ground robots: the target alone

@@ -31,7 +31,12 @@ from numpy.typing import ArrayLike, NDArray
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.names import unknown_name
 from seminspect.core.params import PRESETS, InspectionParams
-from seminspect.geometry.polygons import polygon_centroid, polygon_contains, ring_polygon
+from seminspect.geometry.polygons import (
+    hull_polygon,
+    polygon_centroid,
+    polygon_contains,
+    ring_polygon,
+)
 from seminspect.geometry.transforms import IDENTITY_QUAT, as_point, as_quaternion, yaw_from_quat
 from seminspect.graphs.lsg import naming
 from seminspect.graphs.lsg.model import (
@@ -483,7 +488,7 @@ class LayeredSemanticGraph:
         )
         return self.add_feature(feature)
 
-    def finish_inspection(self, polygon_level: int = 0) -> TargetNode:
+    def finish_inspection(self, polygon_level: int = 0, every_level: bool = False) -> TargetNode:
         """Close the last level, build the containment polygon and mark the target inspected.
 
         The polygon's vertices are the pose nodes of the first level (000 Sec V-B), or of level
@@ -493,6 +498,10 @@ class LayeredSemanticGraph:
         targets that the polygon now contains, or that lie within ``d_check^T`` of the refined
         position, are re-detections of this target and are removed (000 Fig 17f);
         :attr:`pruned` lists them.
+
+        With ``every_level`` the polygon grows with what was seen: it is the convex hull of every
+        level's poses. A structure much larger than the camera's footprint may be circled only
+        in part at some level, and one level's ring then covers only part of it.
         """
         inspection = self._require_inspection()
         self.close_level()
@@ -500,7 +509,10 @@ class LayeredSemanticGraph:
         levels = target.levels
         if not 0 <= polygon_level < len(levels):
             raise InvalidInputError(f"{target.id} has no level {polygon_level}")
-        polygon = ring_polygon([p.position[:2] for p in levels[polygon_level].poses])
+        if every_level:
+            polygon = hull_polygon([p.position[:2] for level in levels for p in level.poses])
+        else:
+            polygon = ring_polygon([p.position[:2] for p in levels[polygon_level].poses])
         if polygon is not None:
             target.polygon = polygon
             centre = polygon_centroid(polygon)

@@ -11,7 +11,7 @@ from enum import Enum
 import numpy as np
 from numpy.typing import NDArray
 
-from seminspect.geometry.polygons import polygon_contains
+from seminspect.geometry.polygons import polygon_contains, polygon_meets_sector
 from seminspect.geometry.spatial_hash import PointHash
 from seminspect.geometry.transforms import bearing_offset
 from seminspect.perception.observation import Observation
@@ -69,18 +69,24 @@ def inspected_in_view(
     from the optical axis here, so a point is in view when ``|θ| <= α / 2``. An inspected
     target is in view when its centre or any vertex of its containment polygon is: seen from
     close by, an 8 m truck can fill one side of the image while its centre lies outside it.
+    It is also in view when its polygon overlaps the field of view out to ``d_max``: a robot
+    beside (or above) a building 40 m long can face its wall with every vertex and the centre
+    out of the image, and the centre farther than ``d_max``.
     """
     half_fov = 0.5 * fov_rad
 
-    def visible(view: InspectedView) -> bool:
+    def centre_or_vertex_in_view(view: InspectedView) -> bool:
+        if np.linalg.norm(view.position - robot_position) > d_max:
+            return False
         points = [view.position[:2]] + ([] if view.polygon is None else list(view.polygon))
         return any(bearing_offset(robot_position, robot_yaw, p) <= half_fov for p in points)
 
-    return [
-        view
-        for view in inspected
-        if np.linalg.norm(view.position - robot_position) <= d_max and visible(view)
-    ]
+    def polygon_in_view(view: InspectedView) -> bool:
+        return view.polygon is not None and polygon_meets_sector(
+            view.polygon, robot_position, robot_yaw, half_fov, d_max
+        )
+
+    return [v for v in inspected if centre_or_vertex_in_view(v) or polygon_in_view(v)]
 
 
 def optimise_targets(

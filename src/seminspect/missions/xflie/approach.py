@@ -29,6 +29,13 @@ from seminspect.planning.volumetric import RebuildingVolumetricPlanner
 
 #: Extra clearance added to the robot radius in the planners' inflation [m].
 PLANNING_MARGIN = 0.2
+#: The same for aerial robots [m]. A flying robot's clearance is measured in 3D between the
+#: centres of 0.3 m voxels, which can lie up to half a cell diagonal (0.26 m) beyond the surface
+#: they hold; the simulator's collision field is itself conservative (a lower bound that may
+#: understate the distance to a surface by 0.69 m in the 0.2 m grid of the collapsed-building
+#: sites, ``worlds/collision.py``). A 0.2 m margin let the robot graze a leaning slab it had
+#: mapped correctly; 0.8 m keeps every motion clear of both.
+AERIAL_PLANNING_MARGIN = 0.8
 #: Risk band of the local planner's cost model [m].
 LOCAL_RISK_RADIUS = 0.3
 #: The volumetric baseline's map resolution and risk band (000 Sec VII-D: D*+ on M_0.4, risk
@@ -121,9 +128,15 @@ class Approach:
         ctx.navigator.drive(route)
 
 
+def planning_clearance(config: ResolvedMissionConfig) -> float:
+    """The distance the planners keep between the robot's centre and mapped structure [m]."""
+    margin = AERIAL_PLANNING_MARGIN if config.mode == "aerial" else PLANNING_MARGIN
+    return config.robot.radius + margin
+
+
 def local_planner(config: ResolvedMissionConfig) -> LocalPlanner:
     """The robot's planner on its own map: routes may enter unknown space at a cost."""
-    clearance = config.robot.radius + PLANNING_MARGIN
+    clearance = planning_clearance(config)
     model = CostModel(clearance, risk_radius=LOCAL_RISK_RADIUS, unknown_cost=1.0)
     return LocalPlanner(model, config.mode, band=config.robot.planning_band())
 
@@ -132,7 +145,7 @@ def baseline_planner(config: ResolvedMissionConfig) -> RebuildingVolumetricPlann
     """000 Sec VII-D's volumetric baseline, when the mission uses it (``planner="volumetric"``)."""
     if config.planner != "volumetric":
         return None
-    clearance = config.robot.radius + PLANNING_MARGIN
+    clearance = planning_clearance(config)
     return RebuildingVolumetricPlanner(
         CostModel(clearance, risk_radius=BASELINE_RISK_RADIUS, unknown_cost=1.0),
         config.robot.planning_band() if config.mode == "ground" else None,

@@ -108,6 +108,7 @@ class XFlie:
             carving_spacing=config.map_carving_spacing,
             timers=self.recorder.timers,
             charge_planning_time=config.charge_planning_time,
+            guard_unknown=config.mode == "aerial",
         )
         self.ctx = MissionContext(
             config,

@@ -75,8 +75,12 @@ class LevelInspection:
             ctx.event("inspection-cancelled", target=target.id, reason="too few views")
             return False
         closed = [i for i, done in enumerate(self.closed_levels) if done]
+        # Aerial robots circle structures much larger than the camera's footprint, each level
+        # perhaps in part: their polygon grows with every level.
         with ctx.timers("graph"):
-            ctx.graph.finish_inspection(polygon_level=closed[0] if closed else 0)
+            ctx.graph.finish_inspection(
+                polygon_level=closed[0] if closed else 0, every_level=ctx.config.mode == "aerial"
+            )
         for pruned in ctx.graph.pruned:
             ctx.event("discarded", target=pruned, reason=f"re-detection of {target.id}")
         return True
@@ -146,8 +150,12 @@ class LevelInspection:
             return False
         here = ctx.platform.position
         goal = here + np.array([0.0, 0.0, self.view.vertical_step])
+        if not ctx.navigator.segment_is_free(here, goal):
+            ctx.event("climb-blocked", target=target.id, height=round(float(goal[2]), 2))
+            return False
         with ctx.timers("driving"):
             motion = ctx.platform.move_to(goal, ctx.platform.yaw)
+        ctx.navigator.sense_lidar()
         if not motion.reached:
             return False
         with ctx.timers("graph"):

@@ -18,6 +18,7 @@ from scipy.spatial import cKDTree
 
 from seminspect.core.errors import PlanningError
 from seminspect.graphs.lsg.model import TargetNode
+from seminspect.mapping.voxel import OCCUPIED
 from seminspect.missions.xflie.context import MissionContext
 from seminspect.planning.view_planner import ViewConstraints, next_view_pose
 
@@ -31,6 +32,8 @@ STEP_SCALES = (1.0, 0.5, 0.25)
 VIEW_DISTANCE_SCALES = (1.0, 0.75)
 #: A view move shorter than this does not count as a step along the surface [m].
 MIN_VIEW_STEP = 0.1
+#: Aerial robots keep their distance from mapped structure within this many viewing distances.
+MAPPED_REACH = 1.5
 
 
 class PointSet:
@@ -90,13 +93,38 @@ class SurfaceTracker:
     def surface(self, mask_points: NDArray[np.float64]) -> NDArray[np.float64]:
         """What the view planner steps along: the target's points in view, and every LiDAR
         return attached to the target (within ``ATTACHED`` of anything seen of it), so that
-        parts of it out of the camera's view and debris beside it are kept at a distance too."""
+        parts of it out of the camera's view and debris beside it are kept at a distance too.
+        Aerial robots add the structure of their map around them (see :meth:`mapped_nearby`)."""
+        parts = [mask_points]
         scan = self.ctx.navigator.last_scan
-        if scan is None or not self.target_cloud.size:
-            return mask_points
-        returns = scan.points[scan.points[:, 2] >= self.ctx.min_height]
-        attached = returns[self.target_cloud.near(returns, ATTACHED)]
-        return np.vstack([mask_points, attached]) if len(mask_points) else attached
+        if scan is not None and self.target_cloud.size:
+            returns = scan.points[scan.points[:, 2] >= self.ctx.min_height]
+            parts.append(returns[self.target_cloud.near(returns, ATTACHED)])
+        if self.ctx.config.mode == "aerial":
+            parts.append(self.mapped_nearby())
+        return np.vstack(parts)
+
+    def mapped_nearby(self) -> NDArray[np.float64]:
+        """Centres of the occupied cells of the robot's map within ``MAPPED_REACH`` viewing
+        distances of it, the ground left out. A flying robot passes over what lies below its
+        camera's view (a wall stub, a fallen slab, rubble); its map still holds what any earlier
+        view or scan saw of them, and the view planner must keep its distance from them too."""
+        voxel_map = self.ctx.occupancy
+        here = self.ctx.platform.position
+        reach = MAPPED_REACH * self.view.d_view
+        lo = np.maximum(voxel_map.world_to_index(here - reach), 0)
+        hi = np.minimum(voxel_map.world_to_index(here + reach) + 1, voxel_map.shape)
+        lo[2] = max(lo[2], voxel_map.world_to_index([0, 0, self.ground_top])[2] + 1)
+        block = voxel_map.states[lo[0] : hi[0], lo[1] : hi[1], lo[2] : hi[2]]
+        cells = np.argwhere(block == OCCUPIED) + lo
+        centres = voxel_map.index_to_world(cells)
+        near = np.linalg.norm((centres - here)[:, :2], axis=1) <= reach
+        return centres[near]
+
+    @property
+    def ground_top(self) -> float:
+        """Height of the highest map cell that may hold the ground [m]."""
+        return self.ctx.min_height + self.ctx.occupancy.resolution
 
     def step_along(self, surface: NDArray[np.float64], target: TargetNode) -> bool:
         """Move to the next view pose of 002 eqs (1)-(2); False when no step is possible.
