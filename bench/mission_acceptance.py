@@ -29,8 +29,11 @@ CITY = [("city", scenario, seed) for scenario in ("small", "medium", "large") fo
 OTHERS = [
     ("campus", None, 0),
     ("subterranean", None, 0),
-    ("collapsed-buildings", "fire-station", 0),
-    ("collapsed-buildings", "industrial", 0),
+    *(
+        ("collapsed-buildings", scenario, seed)
+        for scenario in ("fire-station", "industrial")
+        for seed in (0, 1, 2)
+    ),
 ]
 
 #: 000 Table 3 (simulation) and Table 6 (xFLIE rows): detected/inspected %, RMSE m.
