@@ -9,6 +9,8 @@ from seminspect.missions.config import (
     resolve,
     survey_headings,
 )
+from seminspect.planning.view_planner import ViewConstraints
+from seminspect.worlds import generate_world
 
 
 def test_worlds_bring_their_papers_presets() -> None:
@@ -29,6 +31,15 @@ def test_worlds_bring_their_papers_presets() -> None:
         ("building",),
     )
     assert collapsed.params.d_check_T == 8.0  # 000 Table 2
+
+
+def test_collapsed_building_levels_end_at_the_top_not_at_the_cap() -> None:
+    config = resolve(MissionConfig(world="collapsed-buildings", scenario="industrial"))
+    step = ViewConstraints(d_view=config.inspection.d_view).vertical_step
+    airspace = generate_world("collapsed-buildings", "industrial").bounds[1][2]
+    # more levels than the site's airspace holds at the vertical step, so the top ends them
+    assert config.inspection.max_levels * step > airspace
+    assert resolve(MissionConfig()).inspection.max_levels < config.inspection.max_levels
 
 
 def test_explicit_settings_win_over_defaults() -> None:

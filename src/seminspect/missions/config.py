@@ -149,7 +149,13 @@ class ResolvedMissionConfig(MissionConfig):
 CITY_BUDGETS = {"small": 700.0, "medium": 1400.0, "large": 2800.0}
 DEFAULT_BUDGET_S = 3600.0
 
-#: Per-world defaults: preset, mode, target classes, features, viewing distance, budget.
+#: Level cap among collapsed buildings. 000 gives no cap: levels climb until the structure's
+#: top is in view (eq 8 closes each one), 4 levels on the 7 m fire station and 6 on the 10.5 m
+#: industrial building at the 1.66 m vertical step. The cap is set above what the sites' 14 m
+#: of airspace hold (7 levels from 2 m), so the top, not the cap, ends the climb.
+COLLAPSED_MAX_LEVELS = 16
+#: Per-world defaults: preset, mode, target classes, features, viewing distance, level cap,
+#: budget.
 WORLD_DEFAULTS: dict[str, dict[str, Any]] = {
     "city": {
         "preset": "urban-simulated", "mode": "ground", "d_view": 2.5, "budget": DEFAULT_BUDGET_S,
@@ -161,7 +167,7 @@ WORLD_DEFAULTS: dict[str, dict[str, Any]] = {
     },
     "collapsed-buildings": {
         "preset": "collapsed-buildings", "mode": "aerial", "d_view": 4.0, "budget": 2400.0,
-        "classes": ("building",), "features": BUILDING_FEATURES,
+        "max_levels": COLLAPSED_MAX_LEVELS, "classes": ("building",), "features": BUILDING_FEATURES,
     },
 }  # fmt: skip
 #: A user world (``world`` is a path) takes the city's defaults; it has no scenarios.
@@ -177,7 +183,8 @@ def resolve(config: MissionConfig) -> ResolvedMissionConfig:
     """Fill every ``None`` field with the world's default."""
     defaults = WORLD_DEFAULTS.get(config.world, USER_WORLD_DEFAULTS)
     budget = defaults["budget"]
-    inspection = config.inspection or InspectionConfig(d_view=defaults["d_view"])
+    levels = {"max_levels": defaults["max_levels"]} if "max_levels" in defaults else {}
+    inspection = config.inspection or InspectionConfig(d_view=defaults["d_view"], **levels)
     return ResolvedMissionConfig.model_validate(
         dict(config)
         | {
