@@ -76,6 +76,17 @@ def build_mission(
 ) -> tuple[XFlie, World]:
     """The world (made from ``config`` unless given), the robot in it and the executive."""
     world = world or open_world(config.world, config.scenario, seed=config.seed)
+    platform, ground_z = build_platform(config, world)
+    occupancy = VoxelMap.covering(world, config.map_resolution)
+    mission = XFlie(config, platform, occupancy, ground_z=ground_z, run=run, progress=progress)
+    return mission, world
+
+
+def build_platform(
+    config: ResolvedMissionConfig, world: World, name: str | None = None
+) -> tuple[SimulatedPlatform, float]:
+    """The simulated robot at the world's start, and the height of the ground it stands on;
+    a ``name`` gives a robot of a team noise streams of its own."""
     params = config.params
     # Ground robots carry the camera at body height; aerial ones start at Level-0's height.
     aerial = config.mode == "aerial"
@@ -91,11 +102,9 @@ def build_mission(
         yaw_rate=config.robot.yaw_rate,
         body_height=start_height,
         camera_pitch=math.radians(camera_pitch(config)),
+        name=name,
     )
-    ground_z = float(platform.position[2] - start_height)
-    occupancy = VoxelMap.covering(world, config.map_resolution)
-    mission = XFlie(config, platform, occupancy, ground_z=ground_z, run=run, progress=progress)
-    return mission, world
+    return platform, float(platform.position[2] - start_height)
 
 
 def camera_pitch(config: MissionConfig) -> float:
@@ -124,6 +133,10 @@ def run_mission(
     with stop_on_signals():
         run = RunDirectory(out) if out is not None else RunDirectory.fresh(base, run_name(config))
         with run.claimed(config.model_dump(mode="json")):
+            if config.robots:
+                from seminspect.missions.team_run import run_team  # noqa: PLC0415 - it imports us
+
+                return run_team(run, config, world, queries, progress)
             return _run(run, config, world, queries, progress)
 
 

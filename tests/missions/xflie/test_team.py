@@ -1,0 +1,149 @@
+from dataclasses import dataclass, field
+
+import numpy as np
+import pytest
+
+from fake_platform import CAMERA, FakePlatform, fake_context
+from seminspect.core.errors import InvalidInputError
+from seminspect.missions.xflie import XFlie
+from seminspect.missions.xflie.sightings import register_targets
+from seminspect.missions.xflie.team import Activity, Team, interleave
+from seminspect.sensors import Detection
+
+
+@dataclass
+class ScriptedMember:
+    """Takes steps of the given durations, then is done."""
+
+    name: str
+    durations: list[float]
+    clock: float = 0.0
+    taken: list[float] = field(default_factory=list)
+
+    @property
+    def done(self) -> bool:
+        return len(self.taken) == len(self.durations)
+
+    def step(self) -> Activity:
+        start = self.clock
+        self.clock += self.durations[len(self.taken)]
+        self.taken.append(start)
+        return Activity(self.name, "work", start, self.clock)
+
+
+def test_the_member_whose_clock_is_behind_steps_next_and_ties_go_to_the_first() -> None:
+    first = ScriptedMember("a", [5.0, 5.0, 1.0])
+    second = ScriptedMember("b", [2.0, 2.0, 20.0])
+    steps: list[Activity] = []
+    interleave([first, second], steps.append)
+    # Clocks a: 0, 5, 10, 11 and b: 0, 2, 4, 24; at 0 (a tie) a goes first, at 4 b is behind.
+    assert [(s.robot, s.start) for s in steps] == [
+        ("a", 0.0), ("b", 0.0), ("b", 2.0), ("b", 4.0), ("a", 5.0), ("a", 10.0),
+    ]  # fmt: skip
+    assert first.done and second.done
+
+
+def test_a_step_never_starts_before_a_step_already_taken_by_the_other_robot_began() -> None:
+    rng = np.random.default_rng(3)
+    members = [ScriptedMember(n, list(rng.uniform(0.5, 30.0, 12))) for n in "ab"]
+    steps: list[Activity] = []
+    interleave(members, steps.append)
+    assert len(steps) == 24
+    starts = [s.start for s in steps]
+    assert starts == sorted(starts)  # the clock that is behind always moves first
+
+
+def car_ahead(platform: FakePlatform, distance: float = 4.0) -> None:
+    """The fake camera sees a car-sized patch ``distance`` ahead, and detects it."""
+    mask = np.zeros((CAMERA.height, CAMERA.width), bool)
+    mask[100:160, 120:200] = True
+
+    def capture_with_depth(original=platform.capture):
+        frame = original()
+        frame.depth[mask] = distance
+        return frame
+
+    platform.capture = capture_with_depth
+    platform.detections = lambda frame, level, labels: (
+        [Detection("car", mask, int(mask.sum()), 0.9, (120, 100, 200, 160), 1, "instance", 4.0)]
+        if level == "instance" and "car" in labels
+        else []
+    )
+
+
+def two_robots(explorer_at, inspector_at) -> tuple[XFlie, XFlie]:
+    """Two robots on one graph, each with its own (free, known) map."""
+    ctx, _ = fake_context()
+    explorer = XFlie(
+        ctx.config, FakePlatform(explorer_at), ctx.occupancy, ground_z=0.0, name="explorer"
+    )
+    inspector = XFlie(
+        ctx.config,
+        FakePlatform(inspector_at),
+        fake_context()[0].occupancy,
+        ground_z=0.0,
+        graph=explorer.graph,
+        name="inspector",
+    )
+    return explorer, inspector
+
+
+def test_both_robots_seeing_one_car_leave_one_target_in_the_shared_graph() -> None:
+    explorer, inspector = two_robots((0.0, 0.0, 0.7), (0.0, 0.6, 0.7))
+    for mission in (explorer, inspector):
+        car_ahead(mission.platform)  # type: ignore[arg-type]
+        register_targets(mission.ctx, mission.ctx.capture())
+    (car,) = explorer.graph.targets()
+    assert car.observations == 2
+    assert inspector.graph is explorer.graph
+
+
+def test_a_car_only_one_robot_sees_far_from_the_other_is_a_second_target() -> None:
+    explorer, inspector = two_robots((0.0, 0.0, 0.7), (0.0, -8.0, 0.7))
+    for mission in (explorer, inspector):
+        car_ahead(mission.platform)  # type: ignore[arg-type]
+        register_targets(mission.ctx, mission.ctx.capture())
+    cars = explorer.graph.targets()
+    assert len(cars) == 2
+    assert abs(cars[0].position[1] - cars[1].position[1]) > explorer.params.d_check_T
+
+
+def test_on_an_empty_site_the_inspector_waits_for_the_explorer_and_both_stop() -> None:
+    explorer, inspector = two_robots((0.0, 0.0, 0.7), (0.0, 0.0, 0.7))
+    steps: list[Activity] = []
+    team = Team(explorer, inspector, on_step=steps.append)
+    reason = team.execute()
+    assert reason == (
+        "explorer: no frontier left; inspector: every target taken and exploration done"
+    )
+    waits = [s for s in steps if s.robot == "inspector" and s.activity == "wait"]
+    assert waits and all(s.end > s.start for s in waits)
+    assert inspector.platform.time == pytest.approx(explorer.platform.time)
+    assert team.time == max(explorer.platform.time, inspector.platform.time)
+    assert explorer.platform.frames > 0 and inspector.platform.frames == 0
+
+
+def test_the_inspector_selects_by_eq6_from_its_own_pose() -> None:
+    explorer, inspector = two_robots((0.0, 0.0, 0.7), (0.0, -8.0, 0.7))
+    car_ahead(explorer.platform)  # type: ignore[arg-type]
+    team = Team(explorer, inspector)
+    team.explorer.step()  # the first survey registers the car, the graph's x_k is the explorer
+    robot_at_selection = []
+    select = inspector.select
+
+    def watched_select():
+        robot_at_selection.append(inspector.graph.robot.position.copy())
+        return select()
+
+    inspector.select = watched_select  # type: ignore[method-assign]
+    step = team.inspector.step()
+    np.testing.assert_allclose(robot_at_selection[0], (0.0, -8.0, 0.7))
+    assert step.target is not None and step.activity in ("inspect", "skip")
+
+
+def test_a_team_must_share_one_graph() -> None:
+    ctx, _ = fake_context()
+    explorer = XFlie(ctx.config, FakePlatform(), ctx.occupancy, ground_z=0.0)
+    inspector = XFlie(ctx.config, FakePlatform(), ctx.occupancy, ground_z=0.0)
+    with pytest.raises(InvalidInputError, match="share one graph"):
+        Team(explorer, inspector)
