@@ -121,8 +121,9 @@ def print_table(args: argparse.Namespace, rows: dict[int, dict[str, dict[str, An
     faster = 100.0 * (1.0 - mean)
     verdict = "met" if faster >= TARGET_SPEEDUP_PCT else "not met"
     print(
-        f"mean team / one (finish): {mean:.2f}; the team finishes {faster:.0f} % sooner "
-        f"(target >= {TARGET_SPEEDUP_PCT:.0f} %: {verdict})"
+        f"mean team / one (finish): {mean:.2f}; the team finishes {abs(faster):.0f} % "
+        f"{'sooner' if faster >= 0 else 'later'} (target >= {TARGET_SPEEDUP_PCT:.0f} % sooner: "
+        f"{verdict})"
     )
     for seed, kinds in rows.items():
         for kind, row in kinds.items():

@@ -24,6 +24,8 @@ def test_mission_runs_and_says_where_the_results_are(capsys, tmp_path: Path) -> 
         (("mission", "--world", "atlantis"), "unknown world 'atlantis'"),
         (("mission", "--preset", "urban"), "preset"),
         (("mission", "--seed", "-3"), "--seed"),
+        (("mission", "--robots", "explorer,pilot"), "should be 'explorer' or 'inspector'"),
+        (("mission", "--robots", "inspector"), "a team is one explorer and one inspector"),
     ],
 )
 def test_bad_mission_settings_exit_non_zero_with_one_line(capsys, tmp_path, args, message) -> None:
