@@ -14,7 +14,7 @@ from seminspect.graphs.lsg.model import LevelNode, PoseNode, TargetStatus
 from seminspect.missions.config import make_config
 from seminspect.missions.run import run_mission
 from seminspect.missions.rundir import load_robot_trajectories, read_metrics_document
-from seminspect.report.run_pictures import load_events
+from seminspect.report.run_pictures import load_events, render_run
 
 TEAM = {"world": "campus", "scenario": "small", "seed": 0, "robots": ["explorer", "inspector"]}
 
@@ -82,6 +82,8 @@ def test_both_robots_moved_and_each_has_its_trajectory_and_timeline(team_run: Pa
     clocks = [r["mission"]["sim_time_s"] for r in robots.values()]
     assert metrics["mission"]["sim_time_s"] == pytest.approx(max(clocks))
     assert "## Robots" in (team_run / "summary.md").read_text(encoding="utf-8")
+    pictures = [p.name for p in render_run(team_run)]
+    assert pictures == ["trajectory.png", "graph.png", "utility.png", "timeline.png"]
 
 
 @pytest.mark.slow

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -20,6 +20,7 @@ import numpy as np
 
 from seminspect.core.errors import SeminspectError
 from seminspect.core.interrupts import stop_on_signals
+from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.mapping.voxel import VoxelMap
 from seminspect.missions.config import MissionConfig, ResolvedMissionConfig, resolve
 from seminspect.missions.evaluation import (
@@ -155,9 +156,7 @@ def _run(
 
     def write_outputs(end: RunEnd) -> None:
         nonlocal answers, metrics
-        if mission.graph.inspecting is not None:
-            mission.graph.abort_inspection()
-        run.write_graph(mission.graph)  # first: the graph survives whatever fails below
+        write_graph_first(run, mission.graph)
         answers = answer_queries(mission, queries) if end.state == "completed" else []
         metrics = mission_metrics(
             mission, world, cpu, state=end.state, reason=end.reason, answers=answers
@@ -168,6 +167,13 @@ def _run(
     return MissionResult(
         run.root, end.state, end.reason, metrics, mission, world, answers, end.signum
     )
+
+
+def write_graph_first(run: RunDirectory, graph: LayeredSemanticGraph) -> None:
+    """End an inspection cut short and write the graph, so it survives whatever fails next."""
+    if graph.inspecting is not None:
+        graph.abort_inspection()
+    run.write_graph(graph)
 
 
 def answer_queries(mission: XFlie, queries: Sequence[str]) -> list[QueryAnswer]:
@@ -226,17 +232,22 @@ def mission_metrics(
         RunIdentity(config.world, config.scenario, config.seed),
         graph_figures(mission, score, [r.seconds for r in record.plans]),
         quality_figures(mission, world, cpu, score),
-        TargetFigures(
-            score.truths,
-            score.targets,
-            len(score.matches),
-            sum(m.inspected for m in score.matches),
-            score.false_targets,
-            sorted(mission.unreachable),
-            list(score.matches),
-        ),
+        target_figures(score, mission.unreachable),
         mission_figures(mission, cpu),
         list(answers),
+    )
+
+
+def target_figures(score: TargetScore, unreachable: Collection[str]) -> TargetFigures:
+    """The targets found, matched, inspected and given up on."""
+    return TargetFigures(
+        score.truths,
+        score.targets,
+        len(score.matches),
+        sum(m.inspected for m in score.matches),
+        score.false_targets,
+        sorted(unreachable),
+        list(score.matches),
     )
 
 

@@ -26,7 +26,6 @@ from seminspect.missions.metrics import (
     MissionMetrics,
     QueryAnswer,
     RunIdentity,
-    TargetFigures,
 )
 from seminspect.missions.run import (
     MissionResult,
@@ -35,7 +34,9 @@ from seminspect.missions.run import (
     graph_figures,
     mission_figures,
     quality_figures,
+    target_figures,
     truth_targets,
+    write_graph_first,
 )
 from seminspect.missions.rundir import OUTPUT_FILES, RunDirectory, RunEnd, conduct_run
 from seminspect.missions.summary import summary_markdown
@@ -130,9 +131,7 @@ def run_team(
 
     def write_outputs(end: RunEnd) -> None:
         nonlocal answers, metrics
-        if inspector.graph.inspecting is not None:
-            inspector.graph.abort_inspection()
-        run.write_graph(inspector.graph)
+        write_graph_first(run, inspector.graph)
         answers = answer_queries(inspector, queries) if end.state == "completed" else []
         metrics = team_metrics(team, world, cpu, end, answers)
         _write_outputs(run, team, metrics, answers)
@@ -168,15 +167,7 @@ def team_metrics(
         RunIdentity(config.world, config.scenario, config.seed),
         graph_figures(inspector, score, plans),
         quality_figures(inspector, world, cpu, score),
-        TargetFigures(
-            score.truths,
-            score.targets,
-            len(score.matches),
-            sum(m.inspected for m in score.matches),
-            score.false_targets,
-            sorted(inspector.unreachable),
-            list(score.matches),
-        ),
+        target_figures(score, inspector.unreachable),
         combined_figures([r.mission for r in robots], team.time, cpu),
         list(answers),
     )

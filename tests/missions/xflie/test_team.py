@@ -3,12 +3,11 @@ from dataclasses import dataclass, field
 import numpy as np
 import pytest
 
-from fake_platform import CAMERA, FakePlatform, fake_context
+from fake_platform import FakePlatform, car_in_view, fake_context
 from seminspect.core.errors import InvalidInputError
 from seminspect.missions.xflie import XFlie
 from seminspect.missions.xflie.sightings import register_targets
 from seminspect.missions.xflie.team import Activity, Team, interleave
-from seminspect.sensors import Detection
 
 
 @dataclass
@@ -53,24 +52,6 @@ def test_a_step_never_starts_before_a_step_already_taken_by_the_other_robot_bega
     assert starts == sorted(starts)  # the clock that is behind always moves first
 
 
-def car_ahead(platform: FakePlatform, distance: float = 4.0) -> None:
-    """The fake camera sees a car-sized patch ``distance`` ahead, and detects it."""
-    mask = np.zeros((CAMERA.height, CAMERA.width), bool)
-    mask[100:160, 120:200] = True
-
-    def capture_with_depth(original=platform.capture):
-        frame = original()
-        frame.depth[mask] = distance
-        return frame
-
-    platform.capture = capture_with_depth
-    platform.detections = lambda frame, level, labels: (
-        [Detection("car", mask, int(mask.sum()), 0.9, (120, 100, 200, 160), 1, "instance", 4.0)]
-        if level == "instance" and "car" in labels
-        else []
-    )
-
-
 def two_robots(explorer_at, inspector_at) -> tuple[XFlie, XFlie]:
     """Two robots on one graph, each with its own (free, known) map."""
     ctx, _ = fake_context()
@@ -91,7 +72,7 @@ def two_robots(explorer_at, inspector_at) -> tuple[XFlie, XFlie]:
 def test_both_robots_seeing_one_car_leave_one_target_in_the_shared_graph() -> None:
     explorer, inspector = two_robots((0.0, 0.0, 0.7), (0.0, 0.6, 0.7))
     for mission in (explorer, inspector):
-        car_ahead(mission.platform)  # type: ignore[arg-type]
+        car_in_view(mission.platform)  # type: ignore[arg-type]
         register_targets(mission.ctx, mission.ctx.capture())
     (car,) = explorer.graph.targets()
     assert car.observations == 2
@@ -101,7 +82,7 @@ def test_both_robots_seeing_one_car_leave_one_target_in_the_shared_graph() -> No
 def test_a_car_only_one_robot_sees_far_from_the_other_is_a_second_target() -> None:
     explorer, inspector = two_robots((0.0, 0.0, 0.7), (0.0, -8.0, 0.7))
     for mission in (explorer, inspector):
-        car_ahead(mission.platform)  # type: ignore[arg-type]
+        car_in_view(mission.platform)  # type: ignore[arg-type]
         register_targets(mission.ctx, mission.ctx.capture())
     cars = explorer.graph.targets()
     assert len(cars) == 2
@@ -125,7 +106,7 @@ def test_on_an_empty_site_the_inspector_waits_for_the_explorer_and_both_stop() -
 
 def test_the_inspector_selects_by_eq6_from_its_own_pose() -> None:
     explorer, inspector = two_robots((0.0, 0.0, 0.7), (0.0, -8.0, 0.7))
-    car_ahead(explorer.platform)  # type: ignore[arg-type]
+    car_in_view(explorer.platform)  # type: ignore[arg-type]
     team = Team(explorer, inspector)
     team.explorer.step()  # the first survey registers the car, the graph's x_k is the explorer
     robot_at_selection = []

@@ -79,15 +79,14 @@ def interleave(members: Sequence[Member], on_step: Callable[[Activity], None]) -
         on_step(min(active, key=lambda m: m.clock).step())
 
 
-class Explorer:
-    """The explorer's steps: the first survey, then one frontier hop (and survey) per step."""
+class TeamRobot:
+    """What both roles share: the robot's mission, its clock, and why it stopped (once done)."""
 
-    role = "explorer"
+    role = ""
 
     def __init__(self, mission: XFlie) -> None:
         self.mission = mission
         self.started = False
-        self.hops = 0
         self.stop_reason = ""
 
     @property
@@ -97,6 +96,16 @@ class Explorer:
     @property
     def done(self) -> bool:
         return bool(self.stop_reason)
+
+
+class Explorer(TeamRobot):
+    """The explorer's steps: the first survey, then one frontier hop (and survey) per step."""
+
+    role = "explorer"
+
+    def __init__(self, mission: XFlie) -> None:
+        super().__init__(mission)
+        self.hops = 0
 
     def step(self) -> Activity:
         mission, start = self.mission, self.clock
@@ -115,26 +124,16 @@ class Explorer:
         return Activity(self.role, "explore", start, self.clock)
 
 
-class Inspector:
+class Inspector(TeamRobot):
     """The inspector's steps: pursue the next target by eq (6), or wait for the explorer."""
 
     role = "inspector"
 
     def __init__(self, mission: XFlie, explorer: Explorer) -> None:
-        self.mission = mission
+        super().__init__(mission)
         self.explorer = explorer
-        self.started = False
-        self.stop_reason = ""
         #: Targets this robot inspected, in order.
         self.inspected: list[str] = []
-
-    @property
-    def clock(self) -> float:
-        return self.mission.platform.time
-
-    @property
-    def done(self) -> bool:
-        return bool(self.stop_reason)
 
     def step(self) -> Activity:
         mission, start = self.mission, self.clock
