@@ -34,6 +34,7 @@ from seminspect.core.params import PRESETS, InspectionParams
 from seminspect.geometry.polygons import polygon_centroid, polygon_contains, ring_polygon
 from seminspect.geometry.transforms import IDENTITY_QUAT, as_point, as_quaternion, yaw_from_quat
 from seminspect.graphs.lsg import naming
+from seminspect.graphs.lsg.claims import TargetClaims
 from seminspect.graphs.lsg.model import (
     Edge,
     EdgeKind,
@@ -173,6 +174,8 @@ class LayeredSemanticGraph:
         self.next_target_index = 0
         #: Incremented on every change; planners use it to invalidate their caches.
         self.revision = 0
+        #: Which robot has taken which target, when several robots share this graph.
+        self.claims = TargetClaims()
 
     # ------------------------------------------------------------------ access
     def __contains__(self, node_id: object) -> bool:
