@@ -41,7 +41,7 @@ from seminspect.missions.run import (
 from seminspect.missions.rundir import OUTPUT_FILES, RunDirectory, RunEnd, conduct_run
 from seminspect.missions.summary import summary_markdown
 from seminspect.missions.xflie import MissionProgress, XFlie
-from seminspect.missions.xflie.team import Activity, Explorer, Inspector, Team
+from seminspect.missions.xflie.team import Activity, Team, TeamRobot
 from seminspect.planning.local import warm_up
 from seminspect.worlds import World
 
@@ -174,9 +174,7 @@ def team_metrics(
     return TeamMetrics(team_figures, robots)
 
 
-def robot_figures(
-    member: Explorer | Inspector, activities: Sequence[Activity], cpu: CpuMeter
-) -> RobotFigures:
+def robot_figures(member: TeamRobot, activities: Sequence[Activity], cpu: CpuMeter) -> RobotFigures:
     """One robot's figures, and its simulated seconds by activity (its timeline, summed)."""
     seconds: dict[str, float] = {}
     for a in activities:
@@ -186,7 +184,7 @@ def robot_figures(
         member.role,
         member.stop_reason,
         mission_figures(member.mission, cpu),
-        list(member.inspected) if isinstance(member, Inspector) else [],
+        list(member.inspected),
         seconds,
     )
 

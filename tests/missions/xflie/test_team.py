@@ -95,7 +95,7 @@ def test_on_an_empty_site_the_inspector_waits_for_the_explorer_and_both_stop() -
     team = Team(explorer, inspector, on_step=steps.append)
     reason = team.execute()
     assert reason == (
-        "explorer: no frontier left; inspector: every target taken and exploration done"
+        "explorer: no frontier left, then every target taken; inspector: every target taken"
     )
     waits = [s for s in steps if s.robot == "inspector" and s.activity == "wait"]
     assert waits and all(s.end > s.start for s in waits)
@@ -112,9 +112,9 @@ def test_the_inspector_selects_by_eq6_from_its_own_pose() -> None:
     robot_at_selection = []
     select = inspector.select
 
-    def watched_select():
+    def watched_select(**kwargs):
         robot_at_selection.append(inspector.graph.robot.position.copy())
-        return select()
+        return select(**kwargs)
 
     inspector.select = watched_select  # type: ignore[method-assign]
     step = team.inspector.step()
@@ -128,3 +128,45 @@ def test_a_team_must_share_one_graph() -> None:
     inspector = XFlie(ctx.config, FakePlatform(), ctx.occupancy, ground_z=0.0)
     with pytest.raises(InvalidInputError, match="share one graph"):
         Team(explorer, inspector)
+
+
+def test_a_target_the_other_robot_held_at_this_clock_is_taken_only_after_its_release() -> None:
+    explorer, inspector = two_robots((0.0, 0.0, 0.7), (0.0, -8.0, 0.7))
+    car_in_view(explorer.platform)  # type: ignore[arg-type]
+    team = Team(explorer, inspector)
+    team.explorer.step()  # the first survey registers the car (seen ahead at every heading)
+    car, *others = explorer.graph.targets()
+    claims = explorer.graph.claims
+    for target in (car, *others):
+        claims.claim(target.id, "explorer", explorer.platform.time)
+    explorer.platform.wait(500.0)
+    claims.release(car.id, explorer.platform.time)  # the others stay taken
+    waited = team.inspector.step()
+    assert waited.activity == "wait" and waited.end == pytest.approx(explorer.platform.time)
+    taken = team.inspector.step()
+    assert taken.target == car.id and taken.start == pytest.approx(explorer.platform.time)
+    assert [(c.target, c.robot) for c in claims.history if c.target == car.id] == [
+        (car.id, "explorer"),
+        (car.id, "inspector"),
+    ]
+    assert claims.history[-1].until == pytest.approx(inspector.platform.time)
+
+
+def test_once_exploration_is_done_the_explorer_takes_free_targets_by_eq6() -> None:
+    explorer, inspector = two_robots((0.0, 0.0, 0.7), (0.0, -8.0, 0.7))
+    car_in_view(explorer.platform)  # type: ignore[arg-type]
+    inspector.platform.wait(1000.0)  # busy elsewhere: the car is the explorer's to take
+    steps: list[Activity] = []
+    team = Team(explorer, inspector, on_step=steps.append)
+    team.execute()
+    pursuits = [s for s in steps if s.target is not None]
+    explorer_steps = [s for s in steps if s.robot == "explorer"]
+    assert [s.activity for s in explorer_steps[:2]] == ["survey", "explore"]
+    assert pursuits and {s.robot for s in pursuits} == {"explorer"}
+    assert min(s.start for s in pursuits) >= explorer_steps[1].end  # exploring came first
+    claims = explorer.graph.claims.history
+    assert [(c.target, c.robot) for c in claims] == [(s.target, "explorer") for s in pursuits]
+    assert team.explorer.stop_reason.startswith("no frontier left, then ")
+    inspected = [t.id for t in explorer.graph.targets() if t.inspected]
+    assert team.explorer.inspected == [s.target for s in pursuits if s.activity == "inspect"]
+    assert sorted(team.explorer.inspected) == sorted(inspected)

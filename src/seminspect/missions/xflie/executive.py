@@ -19,7 +19,7 @@ Every planner call's wall time is recorded by the :class:`MissionRecorder`; with
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from dataclasses import dataclass
 
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
@@ -173,9 +173,10 @@ class XFlie:
         self.navigator.sense_lidar()
         self.exploration.survey()
 
-    def select(self) -> UtilityTerms | None:
-        """The next target by eq (6) from the robot state in the graph (None: none left)."""
-        choice, terms = select_target(self.graph, exclude=self.unreachable)
+    def select(self, taken: Collection[str] = ()) -> UtilityTerms | None:
+        """The next target by eq (6) from the robot state in the graph (None: none left);
+        targets given up on and those in ``taken`` (another robot's) are not candidates."""
+        choice, terms = select_target(self.graph, exclude=self.unreachable.union(taken))
         self._log_utilities(choice, terms)
         return choice
 

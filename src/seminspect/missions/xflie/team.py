@@ -1,17 +1,21 @@
-"""Two robots, one 3DLSG: an explorer fills the Target layer, an inspector the layers below.
+"""Two robots, one 3DLSG: an explorer fills the Target layer, then both inspect.
 
 Beyond 000, after its Sec IX (heterogeneous robots sharing one graph). Each robot is a whole
 :class:`XFlie` (its own platform, occupancy map, navigator, trajectory and clock) built on the
 same :class:`LayeredSemanticGraph`; the team only decides which phase each one runs next.
 
-* The **explorer** runs ``π^expl:360`` where it starts, then frontier hops with a survey at
-  each, until no frontier is left, its hop cap is spent or its budget ends. Every frame it
-  takes (surveys and transit) registers its target detections in the shared graph.
+* The **explorer, then inspector** runs ``π^expl:360`` where it starts, then frontier hops
+  with a survey at each, until no frontier is left or its hop cap is spent; every frame it
+  takes (surveys and transit) registers its target detections in the shared graph. Once
+  exploration is done it takes targets exactly as the inspector does.
 * The **inspector** takes the next target by eq (6) from the shared graph, with its own pose
   as the robot state ``x_k``, then approaches, confirms and inspects it (Level, Pose and
-  Feature layers) with the single-robot phases. With no target to take it **waits** until the
-  explorer's clock catches up (the explorer may find one meanwhile); it is done when the
-  explorer is done and no uninspected target is left, or at the budget.
+  Feature layers) with the single-robot phases.
+* **Claims.** A robot that selects a target claims it in the graph
+  (:class:`~seminspect.graphs.lsg.claims.TargetClaims`) and releases it when the pursuit
+  ends (inspected, unreachable or discarded); the other robot never selects a target claimed
+  at its own clock. With no free target a robot **waits** until the other's clock if that is
+  ahead (it may find or free one meanwhile), else it stops; both stop at the budget.
 
 **Merge rule.** Every detection, whichever robot made it, goes through the graph's own
 registration and Φ (eqs 3-5), with ``x_k`` the pose of the robot that took the frame: a
@@ -25,8 +29,11 @@ pursuit of one target, a wait): the robot whose clock is behind takes its next s
 tie the explorer goes first, so a target found at time ``t`` is there for an inspector choosing
 at ``t``. Steps are atomic, so one robot's inspection never sees the other change the graph
 half-way; the cost is that a robot may see what the other found up to one step ahead of its
-own clock. Everything is deterministic under the mission's seed. The robots do not perceive
-each other (the simulator has no robot-robot collisions).
+own clock. A claim, though, covers the whole step on the claimant's clock, so a target the
+other robot was pursuing at a given moment is never free to take at that moment, even when
+the pursuit has already ended (and failed) in the order the steps were simulated. Everything
+is deterministic under the mission's seed. The robots do not perceive each other (the
+simulator has no robot-robot collisions).
 """
 
 from __future__ import annotations
@@ -80,7 +87,8 @@ def interleave(members: Sequence[Member], on_step: Callable[[Activity], None]) -
 
 
 class TeamRobot:
-    """What both roles share: the robot's mission, its clock, and why it stopped (once done)."""
+    """What both roles share: the robot's mission, its clock, why it stopped (once done), and
+    taking targets from the shared graph by eq (6), under a claim."""
 
     role = ""
 
@@ -88,6 +96,10 @@ class TeamRobot:
         self.mission = mission
         self.started = False
         self.stop_reason = ""
+        #: The other robot of the team (set by :class:`Team`).
+        self.partner: TeamRobot | None = None
+        #: Targets this robot inspected, in order.
+        self.inspected: list[str] = []
 
     @property
     def clock(self) -> float:
@@ -97,60 +109,23 @@ class TeamRobot:
     def done(self) -> bool:
         return bool(self.stop_reason)
 
-
-class Explorer(TeamRobot):
-    """The explorer's steps: the first survey, then one frontier hop (and survey) per step."""
-
-    role = "explorer"
-
-    def __init__(self, mission: XFlie) -> None:
-        super().__init__(mission)
-        self.hops = 0
-
-    def step(self) -> Activity:
-        mission, start = self.mission, self.clock
-        if not self.started:
-            self.started = True
-            mission.begin()
-            return Activity(self.role, "survey", start, self.clock)
-        if mission.time_left <= 0:
-            self.stop_reason = "time budget spent"
-        elif self.hops >= mission.config.exploration.frontier_max_hops:
-            self.stop_reason = "frontier hop cap reached"
-        elif not mission.explore():
-            self.stop_reason = "no frontier left"
-        else:
-            self.hops += 1
-        return Activity(self.role, "explore", start, self.clock)
-
-
-class Inspector(TeamRobot):
-    """The inspector's steps: pursue the next target by eq (6), or wait for the explorer."""
-
-    role = "inspector"
-
-    def __init__(self, mission: XFlie, explorer: Explorer) -> None:
-        super().__init__(mission)
-        self.explorer = explorer
-        #: Targets this robot inspected, in order.
-        self.inspected: list[str] = []
-
-    def step(self) -> Activity:
-        mission, start = self.mission, self.clock
-        if not self.started:  # its own map starts with what the LiDAR sees from the start
-            self.started = True
-            mission.navigator.sense_lidar()
+    def inspect_next(self, start: float) -> Activity:
+        """Claim the next target by eq (6) from this robot's pose, pursue it, release it; or
+        wait for the partner when no target is free."""
+        mission = self.mission
         if mission.time_left <= MIN_INSPECTION_S:
-            self.stop_reason = "time budget spent"
+            self._stop("time budget spent")
             return Activity(self.role, "stop", start, start)
-        platform = mission.platform
+        platform, claims = mission.platform, mission.graph.claims
         # Eq (6)'s proximity term is measured from this robot, not the one that saw last.
         mission.graph.update_robot(platform.position, quat_from_yaw(platform.yaw), platform.time)
-        choice = mission.select()
+        choice = mission.select(taken=claims.taken_from(self.role, start))
         if choice is None:
             return self._wait(start)
+        claims.claim(choice.target_id, self.role, start)
         target = mission.graph.target(choice.target_id)
         inspected = mission.pursue(target) and target.inspected
+        claims.release(choice.target_id, self.clock)
         if inspected:
             self.inspected.append(target.id)
         return Activity(
@@ -158,13 +133,65 @@ class Inspector(TeamRobot):
         )
 
     def _wait(self, start: float) -> Activity:
-        """No target to take: done if the explorer is, else stand still until it is level."""
-        if self.explorer.done:
-            self.stop_reason = "every target taken and exploration done"
+        """No target is free: stand still until the partner's clock if it is ahead (it may
+        find or free one meanwhile), else stop."""
+        partner = self.partner
+        if partner is None or partner.done or partner.clock <= start:
+            self._stop("every target taken")
             return Activity(self.role, "stop", start, start)
-        self.mission.platform.wait(max(self.explorer.clock - start, 0.0))
+        self.mission.platform.wait(partner.clock - start)
         self.mission.ctx.on_step()
         return Activity(self.role, "wait", start, self.clock)
+
+    def _stop(self, reason: str) -> None:
+        self.stop_reason = reason
+
+
+class Explorer(TeamRobot):
+    """The explorer, then an inspector: the first survey, one frontier hop (and survey) per
+    step until exploration is done, then targets by eq (6) like the inspector."""
+
+    role = "explorer"
+
+    def __init__(self, mission: XFlie) -> None:
+        super().__init__(mission)
+        self.hops = 0
+        #: Why exploration ended ("" while it runs).
+        self.explored = ""
+
+    def step(self) -> Activity:
+        mission, start = self.mission, self.clock
+        if not self.started:
+            self.started = True
+            mission.begin()
+            return Activity(self.role, "survey", start, self.clock)
+        if self.explored:
+            return self.inspect_next(start)
+        if mission.time_left <= 0:
+            self._stop("time budget spent")
+        elif self.hops >= mission.config.exploration.frontier_max_hops:
+            self.explored = "frontier hop cap reached"
+        elif not mission.explore():
+            self.explored = "no frontier left"
+        else:
+            self.hops += 1
+        return Activity(self.role, "explore", start, self.clock)
+
+    def _stop(self, reason: str) -> None:
+        self.stop_reason = f"{self.explored}, then {reason}" if self.explored else reason
+
+
+class Inspector(TeamRobot):
+    """The inspector: targets by eq (6) from the start, waiting for the explorer when none is
+    free."""
+
+    role = "inspector"
+
+    def step(self) -> Activity:
+        if not self.started:  # its own map starts with what the LiDAR sees from the start
+            self.started = True
+            self.mission.navigator.sense_lidar()
+        return self.inspect_next(self.clock)
 
 
 class Team:
@@ -185,7 +212,8 @@ class Team:
         if inspector.graph is not explorer.graph:
             raise InvalidInputError("the explorer and the inspector must share one graph")
         self.explorer = Explorer(explorer)
-        self.inspector = Inspector(inspector, self.explorer)
+        self.inspector = Inspector(inspector)
+        self.explorer.partner, self.inspector.partner = self.inspector, self.explorer
         self.activities: list[Activity] = []
         self._on_step = on_step
 
