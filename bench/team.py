@@ -3,8 +3,9 @@
 For each seed it runs the one-robot xFLIE mission and the explorer + inspector team on the same
 world (default: city large, 20 vehicles) and prints, per seed and over all seeds, the time the
 mission finished (exploration done and every target inspected; the team's is the later of its
-two clocks), the time the last target was inspected, what was found and inspected, and the
-team's times as a ratio of the one robot's. The target is a team at least 30 % faster.
+two clocks), the time the last target was inspected, when the explorer's exploration ended (it
+inspects from then on), what was found and inspected (and by which robot), and the team's
+times as a ratio of the one robot's. The target is a team at least 30 % faster.
 
 Missions of city large take many minutes each, so runs go to ``--runs`` and a completed run of
 the same configuration found there is read instead of run again (``--only one`` or ``--only
@@ -55,7 +56,10 @@ def figures(out: Path) -> dict[str, Any]:
         ),
         "inspecting_s_per_target": inspecting_seconds(events) / max(targets["inspected"], 1),
         "driven": " + ".join(f"{d:.0f}" for d in driven),
-        "explorer_done_s": robots["explorer"]["mission"]["sim_time_s"] if robots else None,
+        "explorer_done_s": exploration_end(events) if robots else None,
+        "inspected_by": (
+            " + ".join(str(len(r["inspected"])) for r in robots.values()) if robots else None
+        ),
         "inspector_wait_s": (
             robots["inspector"]["seconds_by_activity"].get("wait", 0.0) if robots else None
         ),
@@ -64,6 +68,17 @@ def figures(out: Path) -> dict[str, Any]:
         "false": targets["false_targets"],
         "wall_s": metrics["mission"]["wall_time_s"],
     }
+
+
+def exploration_end(events: list[dict[str, Any]]) -> float:
+    """When the explorer's last exploration step ended (it inspects from then on)."""
+    return max(
+        e["end"]
+        for e in events
+        if e["event"] == "activity"
+        and e["robot"] == "explorer"
+        and e["activity"] in ("survey", "explore")
+    )
 
 
 def inspecting_seconds(events: list[dict[str, Any]]) -> float:
@@ -104,7 +119,7 @@ def print_table(args: argparse.Namespace, rows: dict[int, dict[str, dict[str, An
     print(f"{args.world} {args.scenario}: one robot vs explorer + inspector (simulated seconds)")
     print(
         "| seed | one robot: finish | last inspection | driven (m) | team: finish "
-        "| last inspection | explorer done | driven (explorer + inspector, m) "
+        "| last inspection | exploration done | driven (explorer + inspector, m) "
         "| team / one (finish) |"
     )
     print("|---|---|---|---|---|---|---|---|---|")
@@ -132,7 +147,8 @@ def print_table(args: argparse.Namespace, rows: dict[int, dict[str, dict[str, An
                 f"false {row['false']}, {row['inspecting_s_per_target']:.0f} s at each "
                 f"inspected target, {row['how']} ({row['wall_s']:.0f} s wall)"
                 + (
-                    f"; inspector waited {row['inspector_wait_s']:.0f} s"
+                    f"; inspected by explorer + inspector {row['inspected_by']}"
+                    f", inspector waited {row['inspector_wait_s']:.0f} s"
                     if row["inspector_wait_s"] is not None
                     else ""
                 )
