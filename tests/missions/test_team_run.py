@@ -11,10 +11,12 @@ import pytest
 
 from seminspect.graphs.lsg.io import load_graph
 from seminspect.graphs.lsg.model import LevelNode, PoseNode, TargetStatus
-from seminspect.missions.config import make_config
+from seminspect.missions.config import make_config, resolve
 from seminspect.missions.run import run_mission
 from seminspect.missions.rundir import load_robot_trajectories, read_metrics_document
+from seminspect.missions.team_run import build_team
 from seminspect.report.run_pictures import load_events, render_run
+from seminspect.worlds import open_world
 
 TEAM = {"world": "campus", "scenario": "small", "seed": 0, "robots": ["explorer", "inspector"]}
 
@@ -25,6 +27,16 @@ def team_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     result = run_mission(make_config(TEAM), out)
     assert result.state == "completed", result.reason
     return out
+
+
+def test_both_robots_share_one_graph_and_one_map_but_not_a_body() -> None:
+    config = resolve(make_config(TEAM))
+    team = build_team(config, open_world(config.world, config.scenario, seed=config.seed), None)
+    explorer, inspector = team.explorer.mission, team.inspector.mission
+    assert explorer.graph is inspector.graph
+    assert explorer.occupancy is inspector.occupancy
+    assert explorer.platform is not inspector.platform
+    assert explorer.navigator is not inspector.navigator
 
 
 @pytest.mark.slow

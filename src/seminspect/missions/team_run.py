@@ -1,13 +1,13 @@
 """Running a two-robot mission (``robots = ("explorer", "inspector")``) into a run directory.
 
 The explorer and the inspector are built like the one robot of :mod:`.run` (same world, same
-start, same configuration; each has noise streams of its own) on one shared graph, and
-:class:`~seminspect.missions.xflie.team.Team` interleaves them. The run directory holds what a
-one-robot run holds (``trajectory.csv`` and ``map.npz`` are the explorer's, the robot that maps
-the site) and ``robots/<robot>-trajectory.csv`` for each; every event carries the robot that
-made it, and ``activity`` events make each robot's timeline. ``metrics.json`` holds the
-team's figures (mission time is the later of the two clocks; distances, frames and scans are
-summed) and, under ``robots``, each robot's own.
+start, same configuration; each has noise streams of its own) on one shared graph and one
+shared occupancy map, and :class:`~seminspect.missions.xflie.team.Team` interleaves them. The
+run directory holds what a one-robot run holds (``map.npz`` is the shared map,
+``trajectory.csv`` the explorer's path) and ``robots/<robot>-trajectory.csv`` for each; every
+event carries the robot that made it, and ``activity`` events make each robot's timeline.
+``metrics.json`` holds the team's figures (mission time is the later of the two clocks;
+distances, frames and scans are summed) and, under ``robots``, each robot's own.
 """
 
 from __future__ import annotations
@@ -75,15 +75,19 @@ def build_team(
     run: RunDirectory | None,
     progress: Callable[[MissionProgress], None] | None = None,
 ) -> Team:
-    """Both robots at the world's start, on one graph, with their own maps and clocks."""
+    """Both robots at the world's start, on one graph and one occupancy map, with their own
+    clocks: they start at the same pose, so their frames coincide, and each maps for the
+    other (the inspector drives through what the explorer has seen, and its own scans clear
+    frontiers the explorer would otherwise visit)."""
     graph: LayeredSemanticGraph | None = None
     missions: dict[str, XFlie] = {}
+    shared_map = VoxelMap.covering(world, config.map_resolution)
     for role in ("explorer", "inspector"):
         platform, ground_z = build_platform(config, world, name=role)
         mission = XFlie(
             config,
             platform,
-            VoxelMap.covering(world, config.map_resolution),
+            shared_map,
             ground_z=ground_z,
             run=run,
             progress=_labelled(progress, role),
@@ -244,7 +248,7 @@ def _write_outputs(
 ) -> None:
     explorer, inspector = team.explorer.mission, team.inspector.mission
     run.write_graph(inspector.graph)
-    run.write_map(explorer.occupancy)
+    run.write_map(explorer.occupancy)  # the map both robots built
     run.write_trajectory(explorer.platform.trajectory_rows().tolist())
     for member in team.members:
         run.write_trajectory(member.mission.platform.trajectory_rows().tolist(), member.role)

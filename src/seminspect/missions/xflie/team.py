@@ -1,8 +1,9 @@
 """Two robots, one 3DLSG: an explorer fills the Target layer, then both inspect.
 
 Beyond 000, after its Sec IX (heterogeneous robots sharing one graph). Each robot is a whole
-:class:`XFlie` (its own platform, occupancy map, navigator, trajectory and clock) built on the
-same :class:`LayeredSemanticGraph`; the team only decides which phase each one runs next.
+:class:`XFlie` (its own platform, navigator, trajectory and clock) built on the same
+:class:`LayeredSemanticGraph` (and, as :mod:`seminspect.missions.team_run` builds them, the same
+occupancy map); the team only decides which phase each one runs next.
 
 * The **explorer, then inspector** runs ``π^expl:360`` where it starts, then frontier hops
   with a survey at each, until no frontier is left or its hop cap is spent; every frame it
