@@ -109,6 +109,7 @@ def test_the_inspector_selects_by_eq6_from_its_own_pose() -> None:
     car_in_view(explorer.platform)  # type: ignore[arg-type]
     team = Team(explorer, inspector)
     team.explorer.step()  # the first survey registers the car, the graph's x_k is the explorer
+    inspector.platform.wait(explorer.platform.time)  # level, so the car is known to both
     robot_at_selection = []
     select = inspector.select
 
@@ -152,10 +153,25 @@ def test_a_target_the_other_robot_held_at_this_clock_is_taken_only_after_its_rel
     assert claims.history[-1].until == pytest.approx(inspector.platform.time)
 
 
-def test_once_exploration_is_done_the_explorer_takes_free_targets_by_eq6() -> None:
-    explorer, inspector = two_robots((0.0, 0.0, 0.7), (0.0, -8.0, 0.7))
+def test_while_exploring_the_explorer_takes_only_targets_nearer_it_than_the_inspector() -> None:
+    explorer, inspector = two_robots((0.0, 0.0, 0.7), (0.0, -3.0, 0.7))
     car_in_view(explorer.platform)  # type: ignore[arg-type]
-    inspector.platform.wait(1000.0)  # busy elsewhere: the car is the explorer's to take
+    team = Team(explorer, inspector)
+    team.explorer.step()  # the survey sees the car ahead at every heading: a ring of targets
+    targets = explorer.graph.targets()
+    inspectors = {t.id for t in targets if t.position[1] < -1.5}  # beyond the bisector
+    assert inspectors and len(inspectors) < len(targets)
+    pursuit = team.explorer.step()
+    assert pursuit.target is not None and pursuit.target not in inspectors
+    assert not team.explorer.explored
+
+
+def test_once_exploration_is_done_the_explorer_takes_free_targets_by_eq6() -> None:
+    explorer, inspector = two_robots((0.0, 0.0, 0.7), (0.0, 0.0, 0.7))
+    car_in_view(explorer.platform)  # type: ignore[arg-type]
+    # Where the explorer is, so no target is nearer the explorer while it explores; busy
+    # until t = 1000 s, so every target is the explorer's to take once it is done.
+    inspector.platform.wait(1000.0)
     steps: list[Activity] = []
     team = Team(explorer, inspector, on_step=steps.append)
     team.execute()
@@ -170,3 +186,16 @@ def test_once_exploration_is_done_the_explorer_takes_free_targets_by_eq6() -> No
     inspected = [t.id for t in explorer.graph.targets() if t.inspected]
     assert team.explorer.inspected == [s.target for s in pursuits if s.activity == "inspect"]
     assert sorted(team.explorer.inspected) == sorted(inspected)
+
+
+def test_a_target_seen_after_a_robots_clock_is_not_yet_known_to_it() -> None:
+    explorer, inspector = two_robots((0.0, 0.0, 0.7), (0.0, -8.0, 0.7))
+    car_in_view(explorer.platform)  # type: ignore[arg-type]
+    explorer.platform.wait(100.0)  # its survey, one step, sees the car from t = 100 s on
+    team = Team(explorer, inspector)
+    team.explorer.step()
+    assert explorer.graph.targets() and all(t.stamp >= 100.0 for t in explorer.graph.targets())
+    waited = team.inspector.step()  # at t = 0 the inspector knows of no target yet
+    assert waited.activity == "wait" and waited.end == pytest.approx(explorer.platform.time)
+    taken = team.inspector.step()
+    assert taken.target is not None

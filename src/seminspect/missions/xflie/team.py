@@ -1,14 +1,16 @@
-"""Two robots, one 3DLSG: an explorer fills the Target layer, then both inspect.
+"""Two robots, one 3DLSG: an explorer fills the Target layer, and both inspect.
 
 Beyond 000, after its Sec IX (heterogeneous robots sharing one graph). Each robot is a whole
 :class:`XFlie` (its own platform, navigator, trajectory and clock) built on the same
 :class:`LayeredSemanticGraph` (and, as :mod:`seminspect.missions.team_run` builds them, the same
 occupancy map); the team only decides which phase each one runs next.
 
-* The **explorer, then inspector** runs ``π^expl:360`` where it starts, then frontier hops
-  with a survey at each, until no frontier is left or its hop cap is spent; every frame it
-  takes (surveys and transit) registers its target detections in the shared graph. Once
-  exploration is done it takes targets exactly as the inspector does.
+* The **explorer** runs ``π^expl:360`` where it starts, then frontier hops with a survey at
+  each, until no frontier is left or its hop cap is spent; every frame it takes (surveys and
+  transit) registers its target detections in the shared graph. Before each hop it first
+  takes a free target by eq (6), but only among those **nearer to it than to the inspector**
+  (a vehicle it has just found beside it, not one across the site); once exploration is done
+  it takes any free target, exactly as the inspector does.
 * The **inspector** takes the next target by eq (6) from the shared graph, with its own pose
   as the robot state ``x_k``, then approaches, confirms and inspects it (Level, Pose and
   Feature layers) with the single-robot phases.
@@ -29,23 +31,29 @@ odometry frames coincide at the start and the graph needs no alignment between t
 pursuit of one target, a wait): the robot whose clock is behind takes its next step; on a
 tie the explorer goes first, so a target found at time ``t`` is there for an inspector choosing
 at ``t``. Steps are atomic, so one robot's inspection never sees the other change the graph
-half-way; the cost is that a robot may see what the other found up to one step ahead of its
-own clock. A claim, though, covers the whole step on the claimant's clock, so a target the
-other robot was pursuing at a given moment is never free to take at that moment, even when
-the pursuit has already ended (and failed) in the order the steps were simulated. Everything
-is deterministic under the mission's seed. The robots do not perceive each other (the
-simulator has no robot-robot collisions).
+half-way; the cost is that the graph may hold what the other robot found up to one step
+ahead of this one's clock. So a robot does not select a target last seen after its own clock
+(it is not yet known then; the robot waits for the other if nothing else is free), and a
+claim covers the whole step on the claimant's clock, so a target the other robot was pursuing
+at a given moment is never free to take at that moment, even when the pursuit has already
+ended (and failed) in the order the steps were simulated. Everything is deterministic under
+the mission's seed. The robots do not perceive each other (the simulator has no robot-robot
+collisions).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
+import numpy as np
+
 from seminspect.core.errors import InvalidInputError
 from seminspect.geometry.transforms import quat_from_yaw
+from seminspect.graphs.lsg.model import TargetStatus
 from seminspect.missions.xflie.executive import MIN_INSPECTION_S, XFlie
+from seminspect.planning.utility import UtilityTerms
 
 #: The order the scheduler breaks ties in: the explorer's finds come first.
 ROLES = ("explorer", "inspector")
@@ -113,25 +121,38 @@ class TeamRobot:
     def inspect_next(self, start: float) -> Activity:
         """Claim the next target by eq (6) from this robot's pose, pursue it, release it; or
         wait for the partner when no target is free."""
-        mission = self.mission
-        if mission.time_left <= MIN_INSPECTION_S:
+        if self.mission.time_left <= MIN_INSPECTION_S:
             self._stop("time budget spent")
             return Activity(self.role, "stop", start, start)
-        platform, claims = mission.platform, mission.graph.claims
-        # Eq (6)'s proximity term is measured from this robot, not the one that saw last.
-        mission.graph.update_robot(platform.position, quat_from_yaw(platform.yaw), platform.time)
-        choice = mission.select(taken=claims.taken_from(self.role, start))
+        choice = self._select(start)
         if choice is None:
             return self._wait(start)
-        claims.claim(choice.target_id, self.role, start)
-        target = mission.graph.target(choice.target_id)
+        return self._pursue(choice.target_id, start)
+
+    def _select(self, start: float, also_taken: Collection[str] = ()) -> UtilityTerms | None:
+        """Eq (6) from this robot's pose over the targets no other robot holds at ``start``."""
+        mission = self.mission
+        platform = mission.platform
+        # Eq (6)'s proximity term is measured from this robot, not the one that saw last.
+        mission.graph.update_robot(platform.position, quat_from_yaw(platform.yaw), platform.time)
+        taken = mission.graph.claims.taken_from(self.role, start).union(also_taken)
+        return mission.select(taken=taken | self._seen_after(start))
+
+    def _seen_after(self, start: float) -> set[str]:
+        """Targets last seen after ``start`` (by the other robot, a step ahead): not yet
+        known at this robot's clock."""
+        return {t.id for t in self.mission.graph.targets(TargetStatus.DETECTED) if t.stamp > start}
+
+    def _pursue(self, target_id: str, start: float) -> Activity:
+        """Claim a target, approach, confirm and inspect it, and release it."""
+        mission, claims = self.mission, self.mission.graph.claims
+        claims.claim(target_id, self.role, start)
+        target = mission.graph.target(target_id)
         inspected = mission.pursue(target) and target.inspected
-        claims.release(choice.target_id, self.clock)
+        claims.release(target_id, self.clock)
         if inspected:
-            self.inspected.append(target.id)
-        return Activity(
-            self.role, "inspect" if inspected else "skip", start, self.clock, choice.target_id
-        )
+            self.inspected.append(target_id)
+        return Activity(self.role, "inspect" if inspected else "skip", start, self.clock, target_id)
 
     def _wait(self, start: float) -> Activity:
         """No target is free: stand still until the partner's clock if it is ahead (it may
@@ -149,8 +170,9 @@ class TeamRobot:
 
 
 class Explorer(TeamRobot):
-    """The explorer, then an inspector: the first survey, one frontier hop (and survey) per
-    step until exploration is done, then targets by eq (6) like the inspector."""
+    """The explorer: the first survey, then per step a free target nearer it than the
+    inspector (by eq (6)) or else one frontier hop (and survey), until exploration is done;
+    then any free target by eq (6), like the inspector."""
 
     role = "explorer"
 
@@ -168,6 +190,10 @@ class Explorer(TeamRobot):
             return Activity(self.role, "survey", start, self.clock)
         if self.explored:
             return self.inspect_next(start)
+        if mission.time_left > MIN_INSPECTION_S:
+            choice = self._select(start, also_taken=self._nearer_the_partner())
+            if choice is not None:
+                return self._pursue(choice.target_id, start)
         if mission.time_left <= 0:
             self._stop("time budget spent")
         elif self.hops >= mission.config.exploration.frontier_max_hops:
@@ -177,6 +203,19 @@ class Explorer(TeamRobot):
         else:
             self.hops += 1
         return Activity(self.role, "explore", start, self.clock)
+
+    def _nearer_the_partner(self) -> set[str]:
+        """Uninspected targets no nearer this robot than the partner (where the partner is at
+        its own clock): the partner's to take while this one explores."""
+        partner = self.partner
+        if partner is None:
+            return set()
+        here, there = self.mission.platform.position, partner.mission.platform.position
+        return {
+            t.id
+            for t in self.mission.graph.targets(TargetStatus.DETECTED)
+            if np.linalg.norm(t.position - here) >= np.linalg.norm(t.position - there)
+        }
 
     def _stop(self, reason: str) -> None:
         self.stop_reason = f"{self.explored}, then {reason}" if self.explored else reason
@@ -189,7 +228,7 @@ class Inspector(TeamRobot):
     role = "inspector"
 
     def step(self) -> Activity:
-        if not self.started:  # its own map starts with what the LiDAR sees from the start
+        if not self.started:  # a first LiDAR scan where it starts, as the explorer takes
             self.started = True
             self.mission.navigator.sense_lidar()
         return self.inspect_next(self.clock)
