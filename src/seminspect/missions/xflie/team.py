@@ -130,7 +130,8 @@ class TeamRobot:
         return self._pursue(choice.target_id, start)
 
     def _select(self, start: float, also_taken: Collection[str] = ()) -> UtilityTerms | None:
-        """Eq (6) from this robot's pose over the targets no other robot holds at ``start``."""
+        """Eq (6) from this robot's pose over the targets no other robot holds at ``start``,
+        already seen by then, and not in ``also_taken``."""
         mission = self.mission
         platform = mission.platform
         # Eq (6)'s proximity term is measured from this robot, not the one that saw last.
@@ -238,7 +239,7 @@ class Team:
     """An explorer and an inspector on one graph, interleaved by their clocks.
 
     Args:
-        explorer: the explorer's mission (its phases are used for exploring only).
+        explorer: the explorer's mission (it explores, and inspects as described above).
         inspector: the inspector's mission, built on the explorer's graph.
         on_step: called with every step taken (e.g. to log it).
     """
