@@ -37,6 +37,12 @@ def test_the_frontier_explorer_runs_from_the_command_line(capsys, tmp_path: Path
         (("mission", "--seed", "-3"), "--seed"),
         (("mission", "--planner", "gbplanner"), "--planner"),
         (("mission", "--carving-spacing", "9"), "--carving-spacing"),
+        (("mission", "--robots", "explorer,pilot"), "should be 'explorer' or 'inspector'"),
+        (("mission", "--robots", "inspector"), "a team is one explorer and one inspector"),
+        (
+            ("mission", "--robots", "explorer,inspector", "--planner", "frontier"),
+            "a team inspects",
+        ),
     ],
 )
 def test_bad_mission_settings_exit_non_zero_with_one_line(capsys, tmp_path, args, message) -> None:

@@ -57,11 +57,20 @@ def test_explicit_settings_win_over_defaults() -> None:
         ({"robot": {"radius": -1}}, "robot.radius"),
         ({"map_carving_spacing": 0}, "map_carving_spacing"),
         ({"warp_drive": True}, "warp_drive"),
+        ({"robots": ["explorer", "pilot"]}, "robots.1: Input should be 'explorer' or"),
+        ({"robots": ["inspector", "inspector"]}, "one explorer and one inspector"),
+        ({"robots": ["explorer"]}, "one explorer and one inspector, got explorer"),
     ],
 )
 def test_impossible_settings_give_one_line(values, message) -> None:
     with pytest.raises(InvalidInputError, match=message):
         make_config(values)
+
+
+def test_a_team_is_one_explorer_and_one_inspector_in_either_order() -> None:
+    for robots in (["explorer", "inspector"], ["inspector", "explorer"]):
+        assert make_config({"robots": robots}).robots == tuple(robots)
+    assert make_config({}).robots is None
 
 
 def test_survey_covers_the_full_circle() -> None:

@@ -19,6 +19,8 @@ from seminspect.missions.rundir import (
     RunDirectory,
     RunDirectoryInUseError,
     RunDirectoryWarning,
+    load_robot_trajectories,
+    load_trajectory,
     read_run_status,
     resumable_config,
     reusable_run,
@@ -92,6 +94,24 @@ def test_a_new_run_clears_the_old_runs_files_but_never_a_strangers(tmp_path) -> 
         RunDirectory(root).claimed(CONFIG).__enter__()  # refused before the claim is made
     assert (root / "notes.txt").exists() and (root / "config.json").exists()
     assert not (root / LOCK_FILE).exists()
+
+
+def test_a_teams_trajectories_are_written_per_robot_and_cleared_by_the_next_run(
+    tmp_path,
+) -> None:
+    root = tmp_path / "run"
+    rows = {"explorer": [[0.0] * 9, [1.0] * 9], "inspector": [[2.0] * 9]}
+    with RunDirectory(root).claimed(CONFIG) as run:
+        run.write_trajectory(rows["explorer"])
+        for robot, robot_rows in rows.items():
+            run.write_trajectory(robot_rows, robot)
+        run.finish("completed")
+    trajectories = load_robot_trajectories(root)
+    assert {k: v.tolist() for k, v in trajectories.items()} == rows
+    assert load_trajectory(root).tolist() == rows["explorer"]
+    with RunDirectory(root).claimed(CONFIG) as run:  # a one-robot run over a team's
+        assert load_robot_trajectories(root) == {}
+        run.finish("completed")
 
 
 def test_a_failure_inside_the_claim_is_recorded(tmp_path) -> None:

@@ -87,6 +87,11 @@ def app(
     bag: Path | None = typer.Option(
         None, "--bag", help="Replay the run's LiDAR stream into this new ROS2 bag (directory)."
     ),
+    robots: str | None = typer.Option(
+        None,
+        "--robots",
+        help="A team sharing one 3DLSG: 'explorer,inspector' (default: one robot does both).",
+    ),
 ) -> None:
     """Explore a site, inspect every target level by level and build its 3DLSG (paper 000).
 
@@ -107,6 +112,7 @@ def app(
                 "preset": preset, "mode": None if mode is None else mode.value,
                 "noise": noise.value, "planner": planner.value, "time_budget_s": budget,
                 "map_carving_spacing": carving_spacing,
+                "robots": None if robots is None else [r.strip() for r in robots.split(",")],
             }
         )  # fmt: skip
         if out is not None:
@@ -152,6 +158,7 @@ def _resumed(ctx: typer.Context, run_dir: Path):
             "budget",
             "carving_spacing",
             "out",
+            "robots",
         )
         if getattr(ctx.get_parameter_source(name), "name", "DEFAULT") != "DEFAULT"
     ]

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from seminspect.core.params import PRESETS, InspectionParams, PresetName
 from seminspect.core.validation import build
@@ -20,6 +20,10 @@ NoiseName = Literal["ideal", "realistic"]
 #: hierarchical: xFLIE; volumetric: 000 Sec VII-D's baseline between targets; frontier: pure
 #: exploration that never inspects (Table 6's exploration baseline, GBPlanner2.0's role).
 PlannerName = Literal["hierarchical", "volumetric", "frontier"]
+#: A robot's job in a team: the explorer fills the Target layer, the inspector the layers below.
+Role = Literal["explorer", "inspector"]
+#: The teams a mission can field (beyond 000, after its Sec IX): one robot of each role.
+TEAM_ROLES = frozenset({"explorer", "inspector"})
 
 VEHICLE_CLASSES = ("car", "truck")
 
@@ -119,6 +123,26 @@ class MissionConfig(_Strict):
     robot: RobotConfig = RobotConfig()
     inspection: InspectionConfig | None = None
     exploration: ExplorationConfig = ExplorationConfig()
+    robots: tuple[Role, ...] | None = Field(
+        None,
+        description="a team sharing one 3DLSG, e.g. ('explorer', 'inspector'); None: one robot "
+        "that explores and inspects (000)",
+    )
+
+    @field_validator("robots")
+    @classmethod
+    def _one_of_each_role(cls, robots: tuple[Role, ...] | None) -> tuple[Role, ...] | None:
+        if robots is not None and (len(robots) != len(TEAM_ROLES) or set(robots) != TEAM_ROLES):
+            raise ValueError(
+                f"a team is one explorer and one inspector, got {','.join(robots) or 'none'}"
+            )
+        return robots
+
+    @model_validator(mode="after")
+    def _team_inspects(self) -> MissionConfig:
+        if self.robots is not None and self.planner == "frontier":
+            raise ValueError("a team inspects: the frontier planner only explores")
+        return self
 
 
 class ResolvedMissionConfig(MissionConfig):

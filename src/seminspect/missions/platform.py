@@ -102,6 +102,7 @@ class SimulatedPlatform:
     true pose ``image_time_offset_s`` in the past and tagged with the current odometry (the
     image/odometry desync of 000 Sec VII-B). Before each image the robot stands still for
     ``settle_s`` (stop-and-shoot), which removes the desync error for images taken at rest.
+    A robot of a team has a ``name``: its noise is drawn from random streams of its own.
     """
 
     def __init__(
@@ -119,7 +120,10 @@ class SimulatedPlatform:
         camera_pitch: float = 0.0,
         settle_s: float = 0.2,
         capture_s: float = 0.1,
+        name: str | None = None,
     ) -> None:
+        # A named robot (one of a team) draws its noise from streams of its own.
+        streams = () if name is None else (name,)
         self.world = world
         self.camera_pitch = camera_pitch
         self.noise = noise
@@ -137,11 +141,11 @@ class SimulatedPlatform:
             yaw_rate_max=yaw_rate,
             odometry_drift_per_m=noise.odometry_drift_per_m,
             odometry_drift_per_rad=noise.odometry_drift_per_rad,
-            rng=make_rng(seed, "robot", "odometry") if drift else None,
+            rng=make_rng(seed, "robot", "odometry", *streams) if drift else None,
         )
-        self._camera_rng = make_rng(seed, "sensors", "camera")
-        self._detector_rng = make_rng(seed, "sensors", "segmentation")
-        self._lidar_rng = make_rng(seed, "sensors", "lidar")
+        self._camera_rng = make_rng(seed, "sensors", "camera", *streams)
+        self._detector_rng = make_rng(seed, "sensors", "segmentation", *streams)
+        self._lidar_rng = make_rng(seed, "sensors", "lidar", *streams)
         self.frames = 0
         self.scans = 0
         self.blocked_moves = 0

@@ -52,6 +52,7 @@ class MissionRecorder:
         clock: the mission's simulated time (events are stamped with it).
         coverage: what the inspections saw of each target.
         sink: where events go; ``None`` drops them.
+        robot: the robot's name, when it is one of a team (its events carry it).
     """
 
     def __init__(
@@ -59,18 +60,20 @@ class MissionRecorder:
         clock: Callable[[], float],
         coverage: CoverageRecorder,
         sink: EventSink | None = None,
+        robot: str | None = None,
     ) -> None:
         self.timers = Timers()
         self.coverage = coverage
         self._clock = clock
         self._sink = sink
+        self._tags = {} if robot is None else {"robot": robot}
         self._plans: list[PlanningRecord] = []
         self._endings = LevelEndings()
 
     def event(self, kind: str, **fields: object) -> None:
         """One decision of the mission, stamped with the simulated time."""
         if self._sink is not None:
-            self._sink.log_event(kind, self._clock(), **fields)
+            self._sink.log_event(kind, self._clock(), **self._tags, **fields)
 
     def plan(self, goal: str, plan: RoutePlan) -> None:
         """Keep a hierarchical query's timing for the Table 3 planning-time column."""

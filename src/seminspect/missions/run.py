@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -20,6 +20,7 @@ import numpy as np
 
 from seminspect.core.errors import SeminspectError
 from seminspect.core.interrupts import stop_on_signals
+from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.mapping.voxel import VoxelMap
 from seminspect.missions.config import MissionConfig, ResolvedMissionConfig, inspects, resolve
 from seminspect.missions.evaluation import (
@@ -79,6 +80,18 @@ def build_mission(
 ) -> tuple[XFlie, World]:
     """The world (made from ``config`` unless given), the robot in it and the executive."""
     world = world or open_world(config.world, config.scenario, seed=config.seed)
+    platform, ground_z = build_platform(config, world)
+    occupancy = VoxelMap.covering(world, config.map_resolution)
+    executive = XFlie if inspects(config.planner) else FrontierMission
+    mission = executive(config, platform, occupancy, ground_z=ground_z, run=run, progress=progress)
+    return mission, world
+
+
+def build_platform(
+    config: ResolvedMissionConfig, world: World, name: str | None = None
+) -> tuple[SimulatedPlatform, float]:
+    """The simulated robot at the world's start, and the height of the ground it stands on;
+    a ``name`` gives a robot of a team noise streams of its own."""
     params = config.params
     # Ground robots carry the camera at body height; aerial ones start at Level-0's height.
     aerial = config.mode == "aerial"
@@ -94,12 +107,9 @@ def build_mission(
         yaw_rate=config.robot.yaw_rate,
         body_height=start_height,
         camera_pitch=math.radians(camera_pitch(config)),
+        name=name,
     )
-    ground_z = float(platform.position[2] - start_height)
-    occupancy = VoxelMap.covering(world, config.map_resolution)
-    executive = XFlie if inspects(config.planner) else FrontierMission
-    mission = executive(config, platform, occupancy, ground_z=ground_z, run=run, progress=progress)
-    return mission, world
+    return platform, float(platform.position[2] - start_height)
 
 
 def camera_pitch(config: MissionConfig) -> float:
@@ -128,6 +138,10 @@ def run_mission(
     with stop_on_signals():
         run = RunDirectory(out) if out is not None else RunDirectory.fresh(base, run_name(config))
         with run.claimed(config.model_dump(mode="json")):
+            if config.robots:
+                from seminspect.missions.team_run import run_team  # noqa: PLC0415 - it imports us
+
+                return run_team(run, config, world, queries, progress)
             return _run(run, config, world, queries, progress)
 
 
@@ -146,9 +160,7 @@ def _run(
 
     def write_outputs(end: RunEnd) -> None:
         nonlocal answers, metrics
-        if mission.graph.inspecting is not None:
-            mission.graph.abort_inspection()
-        run.write_graph(mission.graph)  # first: the graph survives whatever fails below
+        write_graph_first(run, mission.graph)
         answers = answer_queries(mission, queries) if end.state == "completed" else []
         metrics = mission_metrics(
             mission, world, cpu, state=end.state, reason=end.reason, answers=answers
@@ -159,6 +171,13 @@ def _run(
     return MissionResult(
         run.root, end.state, end.reason, metrics, mission, world, answers, end.signum
     )
+
+
+def write_graph_first(run: RunDirectory, graph: LayeredSemanticGraph) -> None:
+    """End an inspection cut short and write the graph, so it survives whatever fails next."""
+    if graph.inspecting is not None:
+        graph.abort_inspection()
+    run.write_graph(graph)
 
 
 def answer_queries(mission: XFlie, queries: Sequence[str]) -> list[QueryAnswer]:
@@ -217,17 +236,22 @@ def mission_metrics(
         RunIdentity(config.world, config.scenario, config.seed),
         graph_figures(mission, score, [r.seconds for r in record.plans]),
         quality_figures(mission, world, cpu, score),
-        TargetFigures(
-            score.truths,
-            score.targets,
-            len(score.matches),
-            sum(m.inspected for m in score.matches),
-            score.false_targets,
-            sorted(mission.unreachable),
-            list(score.matches),
-        ),
+        target_figures(score, mission.unreachable),
         mission_figures(mission, cpu),
         list(answers),
+    )
+
+
+def target_figures(score: TargetScore, unreachable: Collection[str]) -> TargetFigures:
+    """The targets found, matched, inspected and given up on."""
+    return TargetFigures(
+        score.truths,
+        score.targets,
+        len(score.matches),
+        sum(m.inspected for m in score.matches),
+        score.false_targets,
+        sorted(unreachable),
+        list(score.matches),
     )
 
 

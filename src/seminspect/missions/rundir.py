@@ -9,7 +9,8 @@ Layout::
       config.json       the fully resolved mission configuration and the code that ran it
       graph.json        the final 3DLSG (seminspect.lsg JSON; `seminspect graph ...` reads it)
       snapshots/        the graph after each inspected target, named by simulated time
-      trajectory.csv    time, true and odometry pose of the robot
+      trajectory.csv    time, true and odometry pose of the robot (a team: the explorer)
+      robots/           a team's robots: <robot>-trajectory.csv for each
       events.jsonl      one JSON object per decision (survey, selection, arrival, level, ...),
                         rewritten whole at every checkpoint
       metrics.json      Table 3 and Table 6 figures, mission time, distance
@@ -87,6 +88,7 @@ RUN_FOLDERS = {
     "snapshots": re.compile(r"graph-[\d.]+s\.json"),
     "images": re.compile(r".+\.jpg"),
     "prior": re.compile(r"map\.npz"),
+    "robots": re.compile(r"[a-z]+-trajectory\.csv"),
 }
 #: A temporary file of an atomic write that was cut short: ``.<target>.<random>.<suffix>``.
 _LEFTOVER = re.compile(r"\.(?P<target>.+)\.\w+\.\w+")
@@ -221,11 +223,13 @@ class RunDirectory:
     def write_summary(self, markdown: str) -> None:
         atomic_write_text(self.path("summary.md"), markdown)
 
-    def write_trajectory(self, rows: Sequence[Sequence[float]]) -> None:
-        """Rows of ``t, x, y, z, yaw, odom_x, odom_y, odom_z, odom_yaw``."""
+    def write_trajectory(self, rows: Sequence[Sequence[float]], robot: str | None = None) -> None:
+        """Rows of ``t, x, y, z, yaw, odom_x, odom_y, odom_z, odom_yaw``; a robot of a team
+        writes ``robots/<robot>-trajectory.csv``."""
         header = "t,x,y,z,yaw,odom_x,odom_y,odom_z,odom_yaw\n"
         body = "".join(",".join(f"{v:.4f}" for v in row) + "\n" for row in rows)
-        atomic_write_text(self.path("trajectory.csv"), header + body)
+        name = "trajectory.csv" if robot is None else f"robots/{robot}-trajectory.csv"
+        atomic_write_text(self.path(name), header + body)
 
     def write_image(self, name: str, image: NDArray[np.uint8]) -> str:
         """Save a view image as JPEG; returns its path relative to the run directory."""
@@ -529,9 +533,20 @@ def load_run_world(run_dir: Path) -> World:
     return open_world(config["world"], config["scenario"], seed=config["seed"])
 
 
+def load_robot_trajectories(run_dir: Path) -> dict[str, NDArray[np.float64]]:
+    """Each team robot's trajectory by name (empty for a one-robot run)."""
+    folder = run_dir / "robots"
+    paths = sorted(folder.glob("*-trajectory.csv")) if folder.is_dir() else []
+    return {path.name.removesuffix("-trajectory.csv"): read_trajectory(path) for path in paths}
+
+
 def load_trajectory(run_dir: Path) -> NDArray[np.float64]:
     """Rows of ``t, x, y, z, yaw, odom_x, odom_y, odom_z, odom_yaw`` (none when absent)."""
-    path = run_dir / "trajectory.csv"
+    return read_trajectory(run_dir / "trajectory.csv")
+
+
+def read_trajectory(path: Path) -> NDArray[np.float64]:
+    """A trajectory file's rows (see :func:`load_trajectory`); none when it is absent."""
     if not path.exists():
         return np.empty((0, 9))
     try:

@@ -1,27 +1,5 @@
-import numpy as np
-
-from fake_platform import CAMERA, FakePlatform, fake_context
+from fake_platform import FakePlatform, car_in_view, fake_context
 from seminspect.missions.xflie.sightings import register_targets, target_view
-from seminspect.sensors import Detection
-
-
-def car_in_view(platform: FakePlatform, distance: float = 4.0) -> None:
-    """The fake camera sees a flat car-sized patch ``distance`` ahead, and detects it."""
-    mask = np.zeros((CAMERA.height, CAMERA.width), bool)
-    mask[100:160, 120:200] = True
-
-    def capture_with_depth(original=platform.capture):
-        frame = original()
-        frame.depth[mask] = distance
-        return frame
-
-    platform.capture = capture_with_depth
-    box = (120, 100, 200, 160)
-    platform.detections = lambda frame, level, labels: (
-        [Detection("car", mask, int(mask.sum()), 0.9, box, 1, "instance", distance)]
-        if level == "instance" and "car" in labels
-        else []
-    )
 
 
 def test_a_detected_car_is_registered_where_its_pixels_lie() -> None:

@@ -39,6 +39,7 @@ from seminspect.geometry.polygons import (
 )
 from seminspect.geometry.transforms import IDENTITY_QUAT, as_point, as_quaternion, yaw_from_quat
 from seminspect.graphs.lsg import naming
+from seminspect.graphs.lsg.claims import TargetClaims
 from seminspect.graphs.lsg.model import (
     Edge,
     EdgeKind,
@@ -178,6 +179,8 @@ class LayeredSemanticGraph:
         self.next_target_index = 0
         #: Incremented on every change; planners use it to invalidate their caches.
         self.revision = 0
+        #: Which robot has taken which target, when several robots share this graph.
+        self.claims = TargetClaims()
 
     # ------------------------------------------------------------------ access
     def __contains__(self, node_id: object) -> bool:

@@ -8,7 +8,8 @@
 * :mod:`.inspection`: ``π^insp`` level by level (eqs 7, 9, 10) and climbing;
 * :mod:`.surface`: surface tracking and view steps (002 eqs 1-2);
 * :mod:`.completion`: the end of a level by scene similarity (eq 8) or the safety cap;
-* :mod:`.links`: Target-layer edges between inspected targets and their first routes.
+* :mod:`.links`: Target-layer edges between inspected targets and their first routes;
+* :mod:`.team`: an explorer and an inspector, two executives on one graph (beyond 000).
 """
 
 from seminspect.missions.xflie.approach import PLANNING_MARGIN

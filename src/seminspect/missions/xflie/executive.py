@@ -19,7 +19,7 @@ Every planner call's wall time is recorded by the :class:`MissionRecorder`; with
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from dataclasses import dataclass
 
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
@@ -69,6 +69,8 @@ class XFlie:
         ground_z: height of the ground where the robot started (it stood on it).
         run: where images and events go (optional).
         progress: called after every step with a :class:`MissionProgress`.
+        graph: the 3DLSG to build on, when another robot shares it (default: a new one).
+        name: the robot's name in a team (its events carry it).
     """
 
     def __init__(
@@ -80,6 +82,8 @@ class XFlie:
         ground_z: float,
         run: RunDirectory | None = None,
         progress: Callable[[MissionProgress], None] | None = None,
+        graph: LayeredSemanticGraph | None = None,
+        name: str | None = None,
     ) -> None:
         self.config = config
         self.params = config.params
@@ -89,10 +93,14 @@ class XFlie:
         self.progress = progress
         self.phase = "start"
         self.stop_reason = ""
-        self.graph = LayeredSemanticGraph(self.params, robot_position=platform.position)
+        self.graph = (
+            graph
+            if graph is not None
+            else LayeredSemanticGraph(self.params, robot_position=platform.position)
+        )
         self.planner = HierarchicalPlanner(self.graph)
         self.recorder = MissionRecorder(
-            lambda: platform.time, CoverageRecorder(config.inspection.d_view), run
+            lambda: platform.time, CoverageRecorder(config.inspection.d_view), run, name
         )
         self.local = local_planner(config)
         #: The paper's baseline planner between targets (``planner="volumetric"``).
@@ -144,35 +152,50 @@ class XFlie:
 
     def execute(self) -> str:
         """Run until done or out of time; returns why it stopped."""
-        self._phase("explore-360")
-        self.navigator.sense_lidar()
-        self.exploration.survey()
+        self.begin()
         frontier_hops = 0
         while self.time_left > MIN_INSPECTION_S:
-            choice, terms = select_target(self.graph, exclude=self.unreachable)
-            self._log_utilities(choice, terms)
+            choice = self.select()
             if choice is None:
                 if frontier_hops >= self.config.exploration.frontier_max_hops or not self.explore():
                     self.stop_reason = "no uninspected target and no frontier left"
                     break
                 frontier_hops += 1
                 continue
-            target = self.graph.target(choice.target_id)
-            self._phase("navigate")
-            if not self.approach.reach(target):
-                self.unreachable.add(target.id)
-                self.ctx.event("unreachable", target=target.id)
-                continue
-            if not self.approach.confirm(target):
-                self.graph.discard_target(target.id)
-                self.ctx.event("discarded", target=target.id, reason="not re-observed on arrival")
-                continue
-            self.inspect(target)
-            self._phase("explore-LE")
-            self.exploration.survey()
+            if self.pursue(self.graph.target(choice.target_id)):
+                self._phase("explore-LE")
+                self.exploration.survey()
         if not self.stop_reason:
             self.stop_reason = "time budget spent"
         return self.stop_reason
+
+    def begin(self) -> None:
+        """``π^expl:360`` where the robot starts, after a first LiDAR scan."""
+        self._phase("explore-360")
+        self.navigator.sense_lidar()
+        self.exploration.survey()
+
+    def select(self, taken: Collection[str] = ()) -> UtilityTerms | None:
+        """The next target by eq (6) from the robot state in the graph (None: none left);
+        targets given up on and those in ``taken`` (another robot's) are not candidates."""
+        choice, terms = select_target(self.graph, exclude=self.unreachable.union(taken))
+        self._log_utilities(choice, terms)
+        return choice
+
+    def pursue(self, target: TargetNode) -> bool:
+        """Approach a selected target, confirm it and inspect it; False when it was not
+        reached (it joins the unreachable ones) or not confirmed (it is discarded)."""
+        self._phase("navigate")
+        if not self.approach.reach(target):
+            self.unreachable.add(target.id)
+            self.ctx.event("unreachable", target=target.id)
+            return False
+        if not self.approach.confirm(target):
+            self.graph.discard_target(target.id)
+            self.ctx.event("discarded", target=target.id, reason="not re-observed on arrival")
+            return False
+        self.inspect(target)
+        return True
 
     def explore(self) -> bool:
         """A frontier hop and a survey there; False when no frontier is left."""
