@@ -6,17 +6,9 @@ import pytest
 from seminspect.core.errors import InvalidInputError
 from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap
 from seminspect.planning.frontier import FrontierPlanner, find_frontiers, unknown_area
+from sim_maps import corridor_map
 
 BAND = (0.3, 1.5)
-
-
-def corridor_map() -> VoxelMap:
-    """A 20 m x 10 m map: the west half explored, a wall along y = 8 m, the east half unknown."""
-    grid = VoxelMap.empty([0, 0, -0.25], [20, 10, 2.25], 0.5)
-    grid.states[:20, :, :] = FREE
-    grid.states[:, 16, :] = OCCUPIED  # the wall, unknown beyond it
-    grid.states[:, 17:, :] = UNKNOWN
-    return grid
 
 
 def two_openings_map() -> VoxelMap:
