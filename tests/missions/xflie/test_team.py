@@ -5,6 +5,7 @@ import pytest
 
 from fake_platform import FakePlatform, car_in_view, fake_context
 from seminspect.core.errors import InvalidInputError
+from seminspect.mapping.voxel import FREE, UNKNOWN
 from seminspect.missions.xflie import XFlie
 from seminspect.missions.xflie.sightings import register_targets
 from seminspect.missions.xflie.team import Activity, Team, interleave
@@ -199,3 +200,53 @@ def test_a_target_seen_after_a_robots_clock_is_not_yet_known_to_it() -> None:
     assert waited.activity == "wait" and waited.end == pytest.approx(explorer.platform.time)
     taken = team.inspector.step()
     assert taken.target is not None
+
+
+def on_a_corridor(explorer_at, inspector_at, settings=None) -> Team:
+    """Two robots on one map known free for x in [-5, 5) m, unknown beyond: a frontier at
+    each end."""
+    ctx, _ = fake_context(settings=settings)
+    states = ctx.occupancy.states
+    states[:] = UNKNOWN
+    states[10:30] = FREE
+    explorer = XFlie(
+        ctx.config, FakePlatform(explorer_at), ctx.occupancy, ground_z=0.0, name="explorer"
+    )
+    inspector = XFlie(
+        ctx.config,
+        FakePlatform(inspector_at),
+        ctx.occupancy,
+        ground_z=0.0,
+        graph=explorer.graph,
+        name="inspector",
+    )
+    return Team(explorer, inspector)
+
+
+def test_with_no_free_target_the_inspector_explores_on_its_side_of_the_explorer() -> None:
+    # The west frontier (x = -4.75) is the inspector's nearest, but nearer the explorer.
+    team = on_a_corridor((-4.0, 0.0, 0.7), (-1.0, 0.0, 0.7))
+    step = team.inspector.step()
+    assert step.activity == "explore" and step.end > step.start
+    (goal,) = team.inspector.mission.exploration.spent_frontiers
+    assert goal[0] > 4.0  # the east one
+    assert team.inspector.mission.platform.position[0] > 3.0
+    assert team.inspector.hops == 1 and team.inspector.mission.platform.frames > 0
+
+
+def test_once_the_explorer_has_stopped_exploring_the_inspector_takes_any_frontier() -> None:
+    team = on_a_corridor((-4.0, 0.0, 0.7), (-1.0, 0.0, 0.7))
+    team.explorer.explored = "no frontier left"
+    assert team.inspector.step().activity == "explore"
+    (goal,) = team.inspector.mission.exploration.spent_frontiers
+    assert goal[0] < -4.0  # its nearest
+
+
+def test_the_two_robots_share_one_frontier_hop_cap() -> None:
+    team = on_a_corridor(
+        (-4.0, 0.0, 0.7), (-1.0, 0.0, 0.7), {"exploration": {"frontier_max_hops": 2}}
+    )
+    team.explorer.hops = 2
+    step = team.inspector.step()  # nothing to take, no hop left, the explorer not ahead
+    assert step.activity == "stop" and team.inspector.hops == 0
+    assert not team.inspector.mission.exploration.spent_frontiers
