@@ -9,6 +9,7 @@ from seminspect.mapping.voxel import FREE, UNKNOWN
 from seminspect.missions.xflie import XFlie
 from seminspect.missions.xflie.sightings import register_targets
 from seminspect.missions.xflie.team import Activity, Team, interleave
+from seminspect.planning.frontier import find_frontiers
 
 
 @dataclass
@@ -202,7 +203,7 @@ def test_a_target_seen_after_a_robots_clock_is_not_yet_known_to_it() -> None:
     assert taken.target is not None
 
 
-def on_a_corridor(explorer_at, inspector_at, settings=None) -> Team:
+def on_a_corridor(explorer_at, inspector_at, settings=None, on_step=None) -> Team:
     """Two robots on one map known free for x in [-5, 5) m, unknown beyond: a frontier at
     each end."""
     ctx, _ = fake_context(settings=settings)
@@ -220,7 +221,7 @@ def on_a_corridor(explorer_at, inspector_at, settings=None) -> Team:
         graph=explorer.graph,
         name="inspector",
     )
-    return Team(explorer, inspector)
+    return Team(explorer, inspector, on_step=on_step)
 
 
 def test_with_no_free_target_the_inspector_explores_on_its_side_of_the_explorer() -> None:
@@ -250,3 +251,15 @@ def test_the_two_robots_share_one_frontier_hop_cap() -> None:
     step = team.inspector.step()  # nothing to take, no hop left, the explorer not ahead
     assert step.activity == "stop" and team.inspector.hops == 0
     assert not team.inspector.mission.exploration.spent_frontiers
+
+
+def test_the_team_stops_once_no_frontier_is_left_for_either_robot() -> None:
+    steps: list[Activity] = []
+    team = on_a_corridor((-4.0, 0.0, 0.7), (-1.0, 0.0, 0.7), on_step=steps.append)
+    reason = team.execute()
+    assert reason == (
+        "explorer: no frontier left, then every target taken; inspector: every target taken"
+    )
+    assert ("inspector", "explore") in {(s.robot, s.activity) for s in steps}
+    assert not find_frontiers(team.explorer.mission.occupancy, (0.3, 1.2), 12, 0.7)
+    assert team.explorer.clock == pytest.approx(team.inspector.clock) == team.time
