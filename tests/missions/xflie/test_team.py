@@ -263,3 +263,23 @@ def test_the_team_stops_once_no_frontier_is_left_for_either_robot() -> None:
     assert ("inspector", "explore") in {(s.robot, s.activity) for s in steps}
     assert not find_frontiers(team.explorer.mission.occupancy, (0.3, 1.2), 12, 0.7)
     assert team.explorer.clock == pytest.approx(team.inspector.clock) == team.time
+
+
+def test_an_explorer_that_misses_its_frontiers_explores_on_until_none_is_left() -> None:
+    team = on_a_corridor((-1.0, 0.0, 0.7), (-1.0, 0.0, 0.7))
+    explorer = team.explorer
+    explorer.started = True  # its survey done; every route now fails
+    explorer.mission.navigator.go_to = lambda *args, **kwargs: False  # type: ignore[method-assign]
+    assert explorer.step().activity == "explore"
+    assert len(explorer.mission.exploration.spent_frontiers) == 2  # both ends tried, missed
+    assert explorer.exploring and not explorer.explored
+    explorer.step()
+    assert explorer.explored == "no frontier left" and explorer.hops == 0
+
+
+def test_the_inspector_may_explore_a_frontier_the_explorer_has_spent() -> None:
+    team = on_a_corridor((-4.0, 0.0, 0.7), (-1.0, 0.0, 0.7))
+    team.explorer.mission.exploration.spent_frontiers.append(np.array([-4.75, 0.0, 0.7]))
+    assert team.inspector.step().activity == "explore"
+    (goal,) = team.inspector.mission.exploration.spent_frontiers
+    assert goal[0] < -4.0  # the west end, its nearest, though nearer the explorer

@@ -8,18 +8,20 @@ occupancy map); the team only decides which phase each one runs next.
 
 * The **explorer** prefers exploring: ``π^expl:360`` where it starts, then frontier hops with a
   survey at each (the mission's own nearest-frontier rule, unrestricted), until no frontier is
-  left or the team's hop cap is spent; every frame it takes (surveys and transit) registers
-  its target detections in the shared graph. Before each hop it first takes a free target by
-  eq (6), but only among those **nearer to it than to the inspector** (a vehicle it has just
-  found beside it, not one across the site); once exploration is done it takes any free
-  target, exactly as the inspector does.
+  left to try or the team's hop cap is spent (a hop that could reach none of the frontiers it
+  tried leaves the farther ones for its next step, where a lone robot would stop); every
+  frame it takes (surveys and transit) registers its target detections in the shared graph.
+  Before each hop it first takes a free target by eq (6), but only among those **nearer to it
+  than to the inspector** (a vehicle it has just found beside it, not one across the site);
+  once exploration is done it takes any free target, exactly as the inspector does.
 * The **inspector** prefers inspecting: the next free target by eq (6) from the shared graph,
   with its own pose as the robot state ``x_k``, approached, confirmed and inspected (Level,
   Pose and Feature layers) with the single-robot phases. With no free target it **explores**
   rather than stand idle: a frontier hop and a survey with the same machinery, but while the
   explorer still explores only among frontiers **nearer to it than to the explorer** (the
-  bisector between the two robots splits the frontiers, so they never chase the same one);
-  once the explorer is done, any frontier. The two robots' hops count against one cap, the
+  bisector between the two robots splits the frontiers, so they never chase the same one) or
+  that the explorer has spent (tried, and will not try again); once the explorer is done, any
+  frontier. The two robots' hops count against one cap, the
   mission's ``frontier_max_hops``; each remembers the frontiers it spent (a frontier one robot
   could not reach from where it was stays a candidate for the other).
 * **Claims.** A robot that selects a target claims it in the graph
@@ -55,7 +57,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Literal, Protocol
 
 import numpy as np
 
@@ -67,6 +69,9 @@ from seminspect.planning.utility import UtilityTerms
 
 #: The order the scheduler breaks ties in: the explorer's finds come first.
 ROLES = ("explorer", "inspector")
+
+#: How a frontier hop ended: reached, every frontier tried missed, or none left to try.
+Hop = Literal["hopped", "missed", "none left"]
 
 
 @dataclass(frozen=True)
@@ -95,8 +100,9 @@ class Member(Protocol):
 def interleave(members: Sequence[Member], on_step: Callable[[Activity], None]) -> None:
     """Advance the member whose clock is behind, one step at a time, until every one is done.
 
-    Ties go to the member listed first. A member must end each step done or with its clock
-    moved on, so the loop always ends.
+    Ties go to the member listed first. A member must end each step done, with its clock
+    moved on, or with less left to try (a frontier it missed is not tried again), so the loop
+    always ends.
     """
     while True:
         active = [m for m in members if not m.done]
@@ -182,13 +188,16 @@ class TeamRobot:
         partner_hops = 0 if self.partner is None else self.partner.hops
         return self.hops + partner_hops >= self.mission.config.exploration.frontier_max_hops
 
-    def _hop(self, keep: Callable[[np.ndarray], bool] | None = None) -> bool:
-        """One frontier hop and survey (among the goals ``keep`` accepts); False when no
-        frontier is left for this robot."""
-        if not self.mission.explore(keep):
-            return False
-        self.hops += 1
-        return True
+    def _hop(self, keep: Callable[[np.ndarray], bool] | None = None) -> Hop:
+        """One frontier hop and survey (among the goals ``keep`` accepts): ``"hopped"``;
+        ``"missed"`` when the frontiers tried could not be reached (they are spent for this
+        robot, and the next hop tries others); ``"none left"`` when none was left to try."""
+        exploration = self.mission.exploration
+        spent = len(exploration.spent_frontiers)
+        if self.mission.explore(keep):
+            self.hops += 1
+            return "hopped"
+        return "missed" if len(exploration.spent_frontiers) > spent else "none left"
 
     def _nearer_me(self, point: np.ndarray) -> bool:
         """Whether ``point`` is nearer this robot than the partner (where the partner is at
@@ -245,7 +254,7 @@ class Explorer(TeamRobot):
             self._stop("time budget spent")
         elif self.hop_cap_reached:
             self.explored = "frontier hop cap reached"
-        elif not self._hop():
+        elif self._hop() == "none left":  # a miss leaves the frontiers farther away to try
             self.explored = "no frontier left"
         return Activity(self.role, "explore", start, self.clock)
 
@@ -280,11 +289,18 @@ class Inspector(TeamRobot):
         once it has stopped); None when no such frontier is left, or the hop cap is spent."""
         if self.hop_cap_reached:
             return None
-        partner_exploring = self.partner is not None and self.partner.exploring
-        explored = self._hop(self._nearer_me if partner_exploring else None)
-        if explored or self.clock > start:  # frontiers tried and not reached cost time too
+        partner = self.partner
+        exploring = partner is not None and partner.exploring
+        hop = self._hop(self._may_explore if exploring else None)
+        if hop == "hopped" or self.clock > start:  # frontiers tried and missed cost time too
             return Activity(self.role, "explore", start, self.clock)
         return None
+
+    def _may_explore(self, goal: np.ndarray) -> bool:
+        """While the explorer explores: a frontier nearer this robot than the explorer, or
+        one the explorer has spent (it tried it and will not again)."""
+        assert self.partner is not None  # only asked while the partner explores
+        return self._nearer_me(goal) or self.partner.mission.exploration.is_spent(goal)
 
 
 class Team:
