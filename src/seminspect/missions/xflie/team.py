@@ -21,9 +21,9 @@ occupancy map); the team only decides which phase each one runs next.
   explorer still explores only among frontiers **nearer to it than to the explorer** (the
   bisector between the two robots splits the frontiers, so they never chase the same one) or
   that the explorer has spent (tried, and will not try again); once the explorer is done, any
-  frontier. The two robots' hops count against one cap, the
-  mission's ``frontier_max_hops``; each remembers the frontiers it spent (a frontier one robot
-  could not reach from where it was stays a candidate for the other).
+  frontier. The two robots' hops count against one cap, the mission's ``frontier_max_hops``;
+  each remembers the frontiers it spent (a frontier one robot could not reach from where it
+  was stays a candidate for the other).
 * **Claims.** A robot that selects a target claims it in the graph
   (:class:`~seminspect.graphs.lsg.claims.TargetClaims`) and releases it when the pursuit
   ends (inspected, unreachable or discarded); the other robot never selects a target claimed
@@ -273,8 +273,9 @@ class Explorer(TeamRobot):
 
 class Inspector(TeamRobot):
     """The inspector: the next free target by eq (6); with none free, a frontier hop (and
-    survey) on its own side while the explorer explores (anywhere once it has stopped);
-    with no frontier left for it either, it waits for the explorer."""
+    survey) on its own side of the explorer, or one the explorer spent, while the explorer
+    explores (anywhere once it has stopped); with no frontier left for it either, it waits
+    for the explorer."""
 
     role = "inspector"
 
@@ -285,8 +286,8 @@ class Inspector(TeamRobot):
         return self.inspect_next(self.clock)
 
     def _when_none_free(self, start: float) -> Activity | None:
-        """A frontier hop on this robot's side of the explorer while it explores (anywhere
-        once it has stopped); None when no such frontier is left, or the hop cap is spent."""
+        """A frontier hop by :meth:`_may_explore` while the explorer explores (anywhere once
+        it has stopped); None when no such frontier is left, or the hop cap is spent."""
         if self.hop_cap_reached:
             return None
         partner = self.partner
