@@ -56,3 +56,15 @@ def test_the_explorer_never_inspects_and_is_scored_on_what_it_found(tmp_path: Pa
 def test_an_unknown_planner_is_one_readable_error() -> None:
     with pytest.raises(SeminspectError, match="planner"):
         make_config(frontier_config(100) | {"planner": "gbplanner"})
+
+
+def test_frontiers_it_may_not_keep_are_never_tried() -> None:
+    mission, _ = build_mission(resolve(make_config(frontier_config(300))), None)
+    assert isinstance(mission, FrontierMission)
+    mission.navigator.sense_lidar()
+    mission.exploration.survey()
+    start = mission.platform.position
+    assert not mission.explore(keep=lambda goal: False)
+    assert not mission.frontiers.spent
+    np.testing.assert_array_equal(mission.platform.position, start)
+    assert mission.explore(keep=lambda goal: True)  # there were frontiers to refuse

@@ -19,6 +19,9 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
+import numpy as np
+from numpy.typing import NDArray
+
 from seminspect.mapping.voxel import VoxelMap
 from seminspect.missions.config import ResolvedMissionConfig
 from seminspect.missions.platform import Platform
@@ -67,10 +70,12 @@ class FrontierMission(XFlie):
         self.stop_reason = "time budget spent" if out_of_time else "no frontier left"
         return self.stop_reason
 
-    def explore(self) -> bool:
-        """Drive to the best reachable frontier and survey there; False if none is left."""
+    def explore(self, keep: Callable[[NDArray[np.float64]], bool] | None = None) -> bool:
+        """Drive to the best reachable frontier and survey there; False if none is left
+        (among those whose goal ``keep`` accepts, when given)."""
         self._phase("explore-frontier")
-        for choice in self._candidates()[:FRONTIER_TRIES]:
+        candidates = [c for c in self._candidates() if keep is None or keep(c.frontier.goal)]
+        for choice in candidates[:FRONTIER_TRIES]:
             goal = choice.frontier.goal
             self.frontiers.mark_spent(goal)
             if self.navigator.go_to(goal, radius=FRONTIER_RADIUS):

@@ -53,3 +53,17 @@ def test_no_frontier_means_no_exploration() -> None:
     ctx, events = fake_context()  # everything known
     assert not Exploration(ctx).explore()
     assert events.kinds() == []
+
+
+def test_exploration_chooses_only_among_the_frontiers_it_may_keep() -> None:
+    platform = FakePlatform(position=(-1.0, 0.0, 0.7))
+    ctx, events = fake_context(platform)
+    states = ctx.occupancy.states
+    states[:] = UNKNOWN
+    states[10:30] = FREE  # x in [-5, 5) known: a frontier at each end, the west one nearer
+    exploration = Exploration(ctx)
+    assert not exploration.explore(keep=lambda goal: False)
+    assert events.kinds() == [] and platform.frames == 0 and not exploration.spent_frontiers
+    assert exploration.explore(keep=lambda goal: goal[0] > 0.0)
+    assert events.events[-1]["goal"][0] > 4.0  # the east frontier, though the west is nearer
+    assert platform.position[0] > 3.0

@@ -5,9 +5,11 @@ import pytest
 
 from fake_platform import FakePlatform, car_in_view, fake_context
 from seminspect.core.errors import InvalidInputError
+from seminspect.mapping.voxel import FREE, UNKNOWN
 from seminspect.missions.xflie import XFlie
 from seminspect.missions.xflie.sightings import register_targets
 from seminspect.missions.xflie.team import Activity, Team, interleave
+from seminspect.planning.frontier import find_frontiers
 
 
 @dataclass
@@ -199,3 +201,85 @@ def test_a_target_seen_after_a_robots_clock_is_not_yet_known_to_it() -> None:
     assert waited.activity == "wait" and waited.end == pytest.approx(explorer.platform.time)
     taken = team.inspector.step()
     assert taken.target is not None
+
+
+def on_a_corridor(explorer_at, inspector_at, settings=None, on_step=None) -> Team:
+    """Two robots on one map known free for x in [-5, 5) m, unknown beyond: a frontier at
+    each end."""
+    ctx, _ = fake_context(settings=settings)
+    states = ctx.occupancy.states
+    states[:] = UNKNOWN
+    states[10:30] = FREE
+    explorer = XFlie(
+        ctx.config, FakePlatform(explorer_at), ctx.occupancy, ground_z=0.0, name="explorer"
+    )
+    inspector = XFlie(
+        ctx.config,
+        FakePlatform(inspector_at),
+        ctx.occupancy,
+        ground_z=0.0,
+        graph=explorer.graph,
+        name="inspector",
+    )
+    return Team(explorer, inspector, on_step=on_step)
+
+
+def test_with_no_free_target_the_inspector_explores_on_its_side_of_the_explorer() -> None:
+    # The west frontier (x = -4.75) is the inspector's nearest, but nearer the explorer.
+    team = on_a_corridor((-4.0, 0.0, 0.7), (-1.0, 0.0, 0.7))
+    step = team.inspector.step()
+    assert step.activity == "explore" and step.end > step.start
+    (goal,) = team.inspector.mission.exploration.spent_frontiers
+    assert goal[0] > 4.0  # the east one
+    assert team.inspector.mission.platform.position[0] > 3.0
+    assert team.inspector.hops == 1 and team.inspector.mission.platform.frames > 0
+
+
+def test_once_the_explorer_has_stopped_exploring_the_inspector_takes_any_frontier() -> None:
+    team = on_a_corridor((-4.0, 0.0, 0.7), (-1.0, 0.0, 0.7))
+    team.explorer.explored = "no frontier left"
+    assert team.inspector.step().activity == "explore"
+    (goal,) = team.inspector.mission.exploration.spent_frontiers
+    assert goal[0] < -4.0  # its nearest
+
+
+def test_the_two_robots_share_one_frontier_hop_cap() -> None:
+    team = on_a_corridor(
+        (-4.0, 0.0, 0.7), (-1.0, 0.0, 0.7), {"exploration": {"frontier_max_hops": 2}}
+    )
+    team.explorer.hops = 2
+    step = team.inspector.step()  # nothing to take, no hop left, the explorer not ahead
+    assert step.activity == "stop" and team.inspector.hops == 0
+    assert not team.inspector.mission.exploration.spent_frontiers
+
+
+def test_the_team_stops_once_no_frontier_is_left_for_either_robot() -> None:
+    steps: list[Activity] = []
+    team = on_a_corridor((-4.0, 0.0, 0.7), (-1.0, 0.0, 0.7), on_step=steps.append)
+    reason = team.execute()
+    assert reason == (
+        "explorer: no frontier left, then every target taken; inspector: every target taken"
+    )
+    assert ("inspector", "explore") in {(s.robot, s.activity) for s in steps}
+    assert not find_frontiers(team.explorer.mission.occupancy, (0.3, 1.2), 12, 0.7)
+    assert team.explorer.clock == pytest.approx(team.inspector.clock) == team.time
+
+
+def test_an_explorer_that_misses_its_frontiers_explores_on_until_none_is_left() -> None:
+    team = on_a_corridor((-1.0, 0.0, 0.7), (-1.0, 0.0, 0.7))
+    explorer = team.explorer
+    explorer.started = True  # its survey done; every route now fails
+    explorer.mission.navigator.go_to = lambda *args, **kwargs: False  # type: ignore[method-assign]
+    assert explorer.step().activity == "explore"
+    assert len(explorer.mission.exploration.spent_frontiers) == 2  # both ends tried, missed
+    assert explorer.exploring and not explorer.explored
+    explorer.step()
+    assert explorer.explored == "no frontier left" and explorer.hops == 0
+
+
+def test_the_inspector_may_explore_a_frontier_the_explorer_has_spent() -> None:
+    team = on_a_corridor((-4.0, 0.0, 0.7), (-1.0, 0.0, 0.7))
+    team.explorer.mission.exploration.spent_frontiers.append(np.array([-4.75, 0.0, 0.7]))
+    assert team.inspector.step().activity == "explore"
+    (goal,) = team.inspector.mission.exploration.spent_frontiers
+    assert goal[0] < -4.0  # the west end, its nearest, though nearer the explorer

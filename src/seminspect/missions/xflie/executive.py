@@ -22,6 +22,9 @@ from __future__ import annotations
 from collections.abc import Callable, Collection
 from dataclasses import dataclass
 
+import numpy as np
+from numpy.typing import NDArray
+
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.model import TargetNode
 from seminspect.mapping.voxel import VoxelMap
@@ -197,10 +200,11 @@ class XFlie:
         self.inspect(target)
         return True
 
-    def explore(self) -> bool:
-        """A frontier hop and a survey there; False when no frontier is left."""
+    def explore(self, keep: Callable[[NDArray[np.float64]], bool] | None = None) -> bool:
+        """A frontier hop and a survey there; False when no frontier is left (among those
+        whose goal ``keep`` accepts, when given)."""
         self._phase("explore-frontier")
-        return self.exploration.explore()
+        return self.exploration.explore(keep)
 
     def inspect(self, target: TargetNode) -> None:
         """``π^insp`` on one target, then its Target-layer links and a graph snapshot."""

@@ -55,12 +55,13 @@ class Exploration:
             self.on_frame(ctx.capture())
         ctx.on_step()
 
-    def explore(self) -> bool:
+    def explore(self, keep: Callable[[NDArray[np.float64]], bool] | None = None) -> bool:
         """Drive to the nearest reachable frontier and survey there; False if none is left.
 
         Frontiers within ``FRONTIER_MIN_DISTANCE`` of the robot are skipped: they are the ring
         of ground around its own body that no sensor sees, which no trip resolves. A frontier
-        visited or found unreachable is not chosen again.
+        visited or found unreachable is not chosen again. ``keep`` (default: every frontier)
+        says which frontier goals this robot may choose at all (another robot's are not).
         """
         ctx = self.ctx
         here = ctx.platform.position
@@ -75,7 +76,9 @@ class Exploration:
         candidates = [
             f
             for f in frontiers
-            if distance(f.goal) >= FRONTIER_MIN_DISTANCE and not self.is_spent(f.goal)
+            if distance(f.goal) >= FRONTIER_MIN_DISTANCE
+            and not self.is_spent(f.goal)
+            and (keep is None or keep(f.goal))
         ]
         candidates.sort(key=lambda f: distance(f.goal))
         for frontier in candidates[:FRONTIER_TRIES]:

@@ -1,24 +1,36 @@
-"""Two robots, one 3DLSG: an explorer fills the Target layer, and both inspect.
+"""Two robots, one 3DLSG: both explore and both inspect; an explorer and an inspector differ
+in what each prefers.
 
 Beyond 000, after its Sec IX (heterogeneous robots sharing one graph). Each robot is a whole
 :class:`XFlie` (its own platform, navigator, trajectory and clock) built on the same
 :class:`LayeredSemanticGraph` (and, as :mod:`seminspect.missions.team_run` builds them, the same
 occupancy map); the team only decides which phase each one runs next.
 
-* The **explorer** runs ``π^expl:360`` where it starts, then frontier hops with a survey at
-  each, until no frontier is left or its hop cap is spent; every frame it takes (surveys and
-  transit) registers its target detections in the shared graph. Before each hop it first
-  takes a free target by eq (6), but only among those **nearer to it than to the inspector**
-  (a vehicle it has just found beside it, not one across the site); once exploration is done
-  it takes any free target, exactly as the inspector does.
-* The **inspector** takes the next target by eq (6) from the shared graph, with its own pose
-  as the robot state ``x_k``, then approaches, confirms and inspects it (Level, Pose and
-  Feature layers) with the single-robot phases.
+* The **explorer** prefers exploring: ``π^expl:360`` where it starts, then frontier hops with a
+  survey at each (the mission's own nearest-frontier rule, unrestricted), until no frontier is
+  left to try or the team's hop cap is spent (a hop that could reach none of the frontiers it
+  tried leaves the farther ones for its next step, where a lone robot would stop); every
+  frame it takes (surveys and transit) registers its target detections in the shared graph.
+  Before each hop it first takes a free target by eq (6), but only among those **nearer to it
+  than to the inspector** (a vehicle it has just found beside it, not one across the site);
+  once exploration is done it takes any free target, exactly as the inspector does.
+* The **inspector** prefers inspecting: the next free target by eq (6) from the shared graph,
+  with its own pose as the robot state ``x_k``, approached, confirmed and inspected (Level,
+  Pose and Feature layers) with the single-robot phases. With no free target it **explores**
+  rather than stand idle: a frontier hop and a survey with the same machinery, but while the
+  explorer still explores only among frontiers **nearer to it than to the explorer** (the
+  bisector between the two robots splits the frontiers, so they never chase the same one) or
+  that the explorer has spent (tried, and will not try again); once the explorer is done, any
+  frontier. The two robots' hops count against one cap, the mission's ``frontier_max_hops``;
+  each remembers the frontiers it spent (a frontier one robot could not reach from where it
+  was stays a candidate for the other).
 * **Claims.** A robot that selects a target claims it in the graph
   (:class:`~seminspect.graphs.lsg.claims.TargetClaims`) and releases it when the pursuit
   ends (inspected, unreachable or discarded); the other robot never selects a target claimed
-  at its own clock. With no free target a robot **waits** until the other's clock if that is
-  ahead (it may find or free one meanwhile), else it stops; both stop at the budget.
+  at its own clock. With no free target and nothing it may explore, a robot **waits** until
+  the other's clock if that is ahead (it may find or free a target, or open or leave a
+  frontier, meanwhile), else it stops; both stop at the budget. The team is done when neither
+  robot has a frontier left and every target is inspected or given up.
 
 **Merge rule.** Every detection, whichever robot made it, goes through the graph's own
 registration and Φ (eqs 3-5), with ``x_k`` the pose of the robot that took the frame: a
@@ -45,7 +57,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Literal, Protocol
 
 import numpy as np
 
@@ -57,6 +69,9 @@ from seminspect.planning.utility import UtilityTerms
 
 #: The order the scheduler breaks ties in: the explorer's finds come first.
 ROLES = ("explorer", "inspector")
+
+#: How a frontier hop ended: reached, every frontier tried missed, or none left to try.
+Hop = Literal["hopped", "missed", "none left"]
 
 
 @dataclass(frozen=True)
@@ -85,8 +100,9 @@ class Member(Protocol):
 def interleave(members: Sequence[Member], on_step: Callable[[Activity], None]) -> None:
     """Advance the member whose clock is behind, one step at a time, until every one is done.
 
-    Ties go to the member listed first. A member must end each step done or with its clock
-    moved on, so the loop always ends.
+    Ties go to the member listed first. A member must end each step done, with its clock
+    moved on, or with less left to try (a frontier it missed is not tried again), so the loop
+    always ends.
     """
     while True:
         active = [m for m in members if not m.done]
@@ -96,8 +112,8 @@ def interleave(members: Sequence[Member], on_step: Callable[[Activity], None]) -
 
 
 class TeamRobot:
-    """What both roles share: the robot's mission, its clock, why it stopped (once done), and
-    taking targets from the shared graph by eq (6), under a claim."""
+    """What both roles share: the robot's mission, its clock, why it stopped (once done),
+    taking targets from the shared graph by eq (6) under a claim, and frontier hops."""
 
     role = ""
 
@@ -109,6 +125,8 @@ class TeamRobot:
         self.partner: TeamRobot | None = None
         #: Targets this robot inspected, in order.
         self.inspected: list[str] = []
+        #: Frontier hops this robot made (the team shares one cap).
+        self.hops = 0
 
     @property
     def clock(self) -> float:
@@ -118,16 +136,25 @@ class TeamRobot:
     def done(self) -> bool:
         return bool(self.stop_reason)
 
+    @property
+    def exploring(self) -> bool:
+        """Whether this robot may still take frontier hops."""
+        return not self.done
+
     def inspect_next(self, start: float) -> Activity:
-        """Claim the next target by eq (6) from this robot's pose, pursue it, release it; or
-        wait for the partner when no target is free."""
+        """Claim the next target by eq (6) from this robot's pose, pursue it, release it; or,
+        when no target is free, :meth:`_when_none_free`, else wait for the partner."""
         if self.mission.time_left <= MIN_INSPECTION_S:
             self._stop("time budget spent")
             return Activity(self.role, "stop", start, start)
         choice = self._select(start)
         if choice is None:
-            return self._wait(start)
+            return self._when_none_free(start) or self._wait(start)
         return self._pursue(choice.target_id, start)
+
+    def _when_none_free(self, start: float) -> Activity | None:
+        """What this robot does when no target is free to take (None: wait)."""
+        return None
 
     def _select(self, start: float, also_taken: Collection[str] = ()) -> UtilityTerms | None:
         """Eq (6) from this robot's pose over the targets no other robot holds at ``start``,
@@ -155,9 +182,34 @@ class TeamRobot:
             self.inspected.append(target_id)
         return Activity(self.role, "inspect" if inspected else "skip", start, self.clock, target_id)
 
+    @property
+    def hop_cap_reached(self) -> bool:
+        """Whether the team's frontier hops (both robots', one cap) are spent."""
+        partner_hops = 0 if self.partner is None else self.partner.hops
+        return self.hops + partner_hops >= self.mission.config.exploration.frontier_max_hops
+
+    def _hop(self, keep: Callable[[np.ndarray], bool] | None = None) -> Hop:
+        """One frontier hop and survey (among the goals ``keep`` accepts): ``"hopped"``;
+        ``"missed"`` when the frontiers tried could not be reached (they are spent for this
+        robot, and the next hop tries others); ``"none left"`` when none was left to try."""
+        exploration = self.mission.exploration
+        spent = len(exploration.spent_frontiers)
+        if self.mission.explore(keep):
+            self.hops += 1
+            return "hopped"
+        return "missed" if len(exploration.spent_frontiers) > spent else "none left"
+
+    def _nearer_me(self, point: np.ndarray) -> bool:
+        """Whether ``point`` is nearer this robot than the partner (where the partner is at
+        its own clock): the partner's side of the bisector is the partner's to work."""
+        if self.partner is None:
+            return True
+        here, there = self.mission.platform.position, self.partner.mission.platform.position
+        return bool(np.linalg.norm(point - here) < np.linalg.norm(point - there))
+
     def _wait(self, start: float) -> Activity:
-        """No target is free: stand still until the partner's clock if it is ahead (it may
-        find or free one meanwhile), else stop."""
+        """Nothing to do: stand still until the partner's clock if it is ahead (it may find
+        or free a target, or leave frontiers, meanwhile), else stop."""
         partner = self.partner
         if partner is None or partner.done or partner.clock <= start:
             self._stop("every target taken")
@@ -179,9 +231,12 @@ class Explorer(TeamRobot):
 
     def __init__(self, mission: XFlie) -> None:
         super().__init__(mission)
-        self.hops = 0
         #: Why exploration ended ("" while it runs).
         self.explored = ""
+
+    @property
+    def exploring(self) -> bool:
+        return not (self.done or self.explored)
 
     def step(self) -> Activity:
         mission, start = self.mission, self.clock
@@ -197,25 +252,19 @@ class Explorer(TeamRobot):
                 return self._pursue(choice.target_id, start)
         if mission.time_left <= 0:
             self._stop("time budget spent")
-        elif self.hops >= mission.config.exploration.frontier_max_hops:
+        elif self.hop_cap_reached:
             self.explored = "frontier hop cap reached"
-        elif not mission.explore():
+        elif self._hop() == "none left":  # a miss leaves the frontiers farther away to try
             self.explored = "no frontier left"
-        else:
-            self.hops += 1
         return Activity(self.role, "explore", start, self.clock)
 
     def _nearer_the_partner(self) -> set[str]:
-        """Uninspected targets no nearer this robot than the partner (where the partner is at
-        its own clock): the partner's to take while this one explores."""
-        partner = self.partner
-        if partner is None:
-            return set()
-        here, there = self.mission.platform.position, partner.mission.platform.position
+        """Uninspected targets no nearer this robot than the partner: the partner's to take
+        while this one explores."""
         return {
             t.id
             for t in self.mission.graph.targets(TargetStatus.DETECTED)
-            if np.linalg.norm(t.position - here) >= np.linalg.norm(t.position - there)
+            if not self._nearer_me(t.position)
         }
 
     def _stop(self, reason: str) -> None:
@@ -223,8 +272,10 @@ class Explorer(TeamRobot):
 
 
 class Inspector(TeamRobot):
-    """The inspector: targets by eq (6) from the start, waiting for the explorer when none is
-    free."""
+    """The inspector: the next free target by eq (6); with none free, a frontier hop (and
+    survey) on its own side of the explorer, or one the explorer spent, while the explorer
+    explores (anywhere once it has stopped); with no frontier left for it either, it waits
+    for the explorer."""
 
     role = "inspector"
 
@@ -233,6 +284,24 @@ class Inspector(TeamRobot):
             self.started = True
             self.mission.navigator.sense_lidar()
         return self.inspect_next(self.clock)
+
+    def _when_none_free(self, start: float) -> Activity | None:
+        """A frontier hop by :meth:`_may_explore` while the explorer explores (anywhere once
+        it has stopped); None when no such frontier is left, or the hop cap is spent."""
+        if self.hop_cap_reached:
+            return None
+        partner = self.partner
+        exploring = partner is not None and partner.exploring
+        hop = self._hop(self._may_explore if exploring else None)
+        if hop == "hopped" or self.clock > start:  # frontiers tried and missed cost time too
+            return Activity(self.role, "explore", start, self.clock)
+        return None
+
+    def _may_explore(self, goal: np.ndarray) -> bool:
+        """While the explorer explores: a frontier nearer this robot than the explorer, or
+        one the explorer has spent (it tried it and will not again)."""
+        assert self.partner is not None  # only asked while the partner explores
+        return self._nearer_me(goal) or self.partner.mission.exploration.is_spent(goal)
 
 
 class Team:
