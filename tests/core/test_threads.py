@@ -1,8 +1,10 @@
+import os
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from seminspect.core.threads import rotate_rows
+from seminspect.core.threads import MAX_SENSOR_THREADS, THREADS_ENV, rotate_rows, sensor_threads
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
@@ -28,3 +30,16 @@ def test_rotate_rows_into_a_reused_buffer_gives_the_same_numbers():
 def test_rotate_rows_rotates():
     quarter_turn = Rotation.from_euler("z", 90, degrees=True).as_matrix()
     assert np.allclose(rotate_rows(np.array([[1.0, 0.0, 0.0]]), quarter_turn), [[0, 1, 0]])
+
+
+def test_sensor_threads_keep_to_the_cores_and_the_settings(monkeypatch):
+    monkeypatch.delenv(THREADS_ENV, raising=False)
+    monkeypatch.delenv("OMP_NUM_THREADS", raising=False)
+    cores = len(os.sched_getaffinity(0))
+    assert sensor_threads() == min(MAX_SENSOR_THREADS, cores)
+    monkeypatch.setenv("OMP_NUM_THREADS", "1")  # as Ray sets it for a one-CPU task
+    assert sensor_threads() == 1
+    monkeypatch.setenv(THREADS_ENV, "3")
+    assert sensor_threads() == 3
+    monkeypatch.setenv(THREADS_ENV, "none")  # not a count: ignored
+    assert sensor_threads() == 1

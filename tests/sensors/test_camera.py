@@ -184,3 +184,14 @@ def test_float32_image_noise_is_an_option_with_other_numbers() -> None:
     assert not np.array_equal(frames[0].depth, frames[1].depth)
     assert np.array_equal(np.isfinite(frames[0].depth), np.isfinite(frames[1].depth))
     assert NoiseModel(image_noise_float32=True).is_ideal  # no noise to draw in either dtype
+
+
+def test_a_frame_cast_on_two_threads_is_the_same_frame(wall) -> None:
+    camera = CameraModel()  # 640 x 480: enough rays to split
+    pose = ((0.0, 1.0, 1.5), quat_from_yaw(0.3))
+    noise = noise_preset("realistic")
+    one = render(wall, camera, *pose, noise=noise, rng=make_rng(4, "camera"))
+    two = render(wall, camera, *pose, noise=noise, rng=make_rng(4, "camera"), threads=2)
+    assert np.isfinite(one.depth).any()
+    for name in ("depth", "instance", "class_id", "part_id", "intensity", "face"):
+        np.testing.assert_array_equal(getattr(two, name), getattr(one, name))

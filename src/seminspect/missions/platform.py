@@ -121,10 +121,13 @@ class SimulatedPlatform:
         settle_s: float = 0.2,
         capture_s: float = 0.1,
         name: str | None = None,
+        threads: int = 1,
     ) -> None:
         # A named robot (one of a team) draws its noise from streams of its own.
         streams = () if name is None else (name,)
         self.world = world
+        #: Threads the camera and the LiDAR cast their rays on (the same results on any number).
+        self.threads = threads
         self.camera_pitch = camera_pitch
         self.noise = noise
         self.settle_s = settle_s
@@ -231,6 +234,7 @@ class SimulatedPlatform:
             rng=self._camera_rng,
             stamp=now.time,
             odometry=(now.odometry_position, self._camera_quaternion(now.odometry_yaw)),
+            threads=self.threads,
         )
         self.robot.wait(self.capture_s)
         self.frames += 1
@@ -266,6 +270,7 @@ class SimulatedPlatform:
             noise=self.noise,
             rng=self._lidar_rng,
             stamp=state.time,
+            threads=self.threads,
         )
         self.scans += 1
         turn = Rotation.from_euler("z", state.odometry_yaw - state.yaw)

@@ -181,6 +181,7 @@ def render(
     stamp: float = 0.0,
     stride: int = 1,
     odometry: tuple[ArrayLike, ArrayLike] | None = None,
+    threads: int = 1,
 ) -> Frame:
     """Render a frame of ``world`` from the camera pose ``(position, orientation [x,y,z,w])``.
 
@@ -190,6 +191,7 @@ def render(
         stamp: time the frame is tagged with.
         stride: render every ``stride``-th pixel (see :meth:`CameraModel.scaled`).
         odometry: the ``(position, orientation)`` the robot believed it had at ``stamp``.
+        threads: cast the rays on this many threads (the same frame on any number).
     """
     origin = as_point(position, "camera position")
     quat = as_quaternion(orientation, "camera orientation")
@@ -200,7 +202,11 @@ def render(
     rotation = Rotation.from_quat(quat).as_matrix().astype(np.float32)
     rotate_rows(directions_body, rotation, out=directions)
     distance, face = world.raycaster.cast(
-        origin, directions, model.ray_limits, out=(distance, np.empty(count, dtype=np.int32))
+        origin,
+        directions,
+        model.ray_limits,
+        threads,
+        out=(distance, np.empty(count, dtype=np.int32)),
     )
     depth = np.empty(count, dtype=np.float32)
     instance = np.empty(count, dtype=np.int32)
