@@ -10,6 +10,7 @@ multi-threaded one (``tests/core/test_threads.py``).
 from __future__ import annotations
 
 import os
+from concurrent.futures import ThreadPoolExecutor
 from functools import cache
 
 import numpy as np
@@ -57,3 +58,10 @@ def sensor_threads() -> int:
 def _positive(variable: str) -> int | None:
     value = os.environ.get(variable, "").strip()
     return int(value) if value.isdigit() and int(value) >= 1 else None
+
+
+@cache
+def thread_pool(threads: int) -> ThreadPoolExecutor:
+    """One pool of ``threads`` workers per process, shared by the compiled loops that release
+    the GIL (ray casting, map updates), so a mission starts its threads once."""
+    return ThreadPoolExecutor(threads, thread_name_prefix="seminspect")

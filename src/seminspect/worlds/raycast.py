@@ -11,8 +11,6 @@ loop is the fallback where its library cannot be loaded, with the same hits.
 from __future__ import annotations
 
 import itertools
-from concurrent.futures import ThreadPoolExecutor
-from functools import cache
 from typing import NamedTuple
 
 import numpy as np
@@ -21,6 +19,7 @@ from embreex.mesh_construction import TriangleMesh
 from numpy.typing import ArrayLike, NDArray
 
 from seminspect.core.errors import InvalidInputError
+from seminspect.core.threads import thread_pool
 from seminspect.worlds.embree import MAX_TFAR, EmbreeScene, cast_rays, embree_library
 
 #: Embree's "no hit" primitive id.
@@ -98,7 +97,7 @@ class RayCaster:
         if len(parts) == 1:
             cast_part(batch, parts[0])
         else:
-            list(_pool(threads).map(lambda part: cast_part(batch, part), parts))
+            list(thread_pool(threads).map(lambda part: cast_part(batch, part), parts))
         return batch.distance, batch.face
 
     def _cast_compiled(self, batch: _Batch, part: slice) -> None:
@@ -154,8 +153,3 @@ def _parts(count: int, threads: int) -> list[slice]:
         return [slice(0, count)]
     bounds = np.linspace(0, count, threads + 1).astype(int)
     return [slice(int(a), int(b)) for a, b in itertools.pairwise(bounds)]
-
-
-@cache
-def _pool(threads: int) -> ThreadPoolExecutor:
-    return ThreadPoolExecutor(threads, thread_name_prefix="embree")
