@@ -23,7 +23,7 @@ from seminspect.geometry.transforms import as_point, wrap_angle
 from seminspect.robot import Robot
 from seminspect.robot.robot import MoveResult
 from seminspect.sensors import CameraModel, Detection, Frame, Lidar, LidarScan, render
-from seminspect.sensors.noise import NoiseModel, make_noise
+from seminspect.sensors.noise import NoiseModel, NormalStream, make_noise
 from seminspect.sensors.segmentation import detect
 from seminspect.worlds import World
 
@@ -146,7 +146,8 @@ class SimulatedPlatform:
             odometry_drift_per_rad=noise.odometry_drift_per_rad,
             rng=make_rng(seed, "robot", "odometry", *streams) if drift else None,
         )
-        self._camera_rng = make_rng(seed, "sensors", "camera", *streams)
+        # The camera's noise is drawn ahead, off the mission's thread (the same numbers).
+        self._camera_rng = NormalStream(make_rng(seed, "sensors", "camera", *streams), threads)
         self._detector_rng = make_rng(seed, "sensors", "segmentation", *streams)
         self._lidar_rng = make_rng(seed, "sensors", "lidar", *streams)
         self.frames = 0

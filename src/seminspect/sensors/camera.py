@@ -26,7 +26,7 @@ from seminspect.core.errors import InvalidInputError
 from seminspect.core.params import InspectionParams
 from seminspect.core.threads import rotate_rows
 from seminspect.geometry.transforms import Quat, Vec3, as_point, as_quaternion
-from seminspect.sensors.noise import NoiseModel, require_rng
+from seminspect.sensors.noise import NoiseModel, NormalStream, require_rng
 from seminspect.sensors.shading import OCTAVE_WEIGHTS, OCTAVES, shade_hits, surface_tables
 from seminspect.worlds import World
 
@@ -177,7 +177,7 @@ def render(
     orientation: ArrayLike,
     *,
     noise: NoiseModel | None = None,
-    rng: np.random.Generator | None = None,
+    rng: np.random.Generator | NormalStream | None = None,
     stamp: float = 0.0,
     stride: int = 1,
     odometry: tuple[ArrayLike, ArrayLike] | None = None,
@@ -187,7 +187,8 @@ def render(
 
     Args:
         noise: depth and intensity noise (``None``: ideal).
-        rng: generator for the noise; required when the noise model is not ideal.
+        rng: generator for the noise, required when the noise model is not ideal; or a
+            :class:`NormalStream` of its deviates drawn ahead (the same frame).
         stamp: time the frame is tagged with.
         stride: render every ``stride``-th pixel (see :meth:`CameraModel.scaled`).
         odometry: the ``(position, orientation)`` the robot believed it had at ``stamp``.
@@ -256,7 +257,7 @@ def render(
         else as_quaternion(odometry[1], "odometry orientation"),
     )
     if noise is not None and not noise.is_ideal:
-        _add_image_noise(frame, noise, require_rng(rng))
+        _add_image_noise(frame, noise, rng if isinstance(rng, NormalStream) else require_rng(rng))
     return frame
 
 
@@ -280,7 +281,9 @@ def _scratch(count: int) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
     return buffers
 
 
-def _add_image_noise(frame: Frame, noise: NoiseModel, rng: np.random.Generator) -> None:
+def _add_image_noise(
+    frame: Frame, noise: NoiseModel, rng: np.random.Generator | NormalStream
+) -> None:
     """Depth noise with a range-dependent sigma, and pixel noise on the intensity image.
 
     All the normal deviates come from one draw: the hit pixels' depth noise first (row-major),
