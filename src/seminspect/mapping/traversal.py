@@ -157,15 +157,14 @@ def integrate_rays_kernel(  # noqa: PLR0917 - the compiled kernels' arguments, p
     count = ends.shape[0]
     occupy = np.empty(count, dtype=np.int64)
     arguments = (states, grid_origin, resolution, origins, ends, hit, carve_from, occupy)
-    if threads <= 1 or count < MIN_THREADED_RAYS:
-        _carve(*arguments, 0, 1)
-    else:
-        jobs = [
-            thread_pool(threads).submit(_carve, *arguments, part, threads)
-            for part in range(threads)
-        ]
-        for job in jobs:
-            job.result()
+    parts = 1 if count < MIN_THREADED_RAYS else max(1, threads)
+    # The calling thread walks the first part while the pool walks the others.
+    others = [
+        thread_pool(parts).submit(_carve, *arguments, part, parts) for part in range(1, parts)
+    ]
+    _carve(*arguments, 0, parts)
+    for other in others:
+        other.result()
     _occupy(states, occupy)
 
 

@@ -94,10 +94,11 @@ class RayCaster:
         batch = _Batch(starts, dirs, limit, distance, face)
         parts = _parts(count, threads)
         cast_part = self._cast_compiled if self._compiled is not None else self._cast_embreex
-        if len(parts) == 1:
-            cast_part(batch, parts[0])
-        else:
-            list(thread_pool(threads).map(lambda part: cast_part(batch, part), parts))
+        # The calling thread casts the first part while the pool casts the others.
+        others = [thread_pool(threads).submit(cast_part, batch, part) for part in parts[1:]]
+        cast_part(batch, parts[0])
+        for other in others:
+            other.result()
         return batch.distance, batch.face
 
     def _cast_compiled(self, batch: _Batch, part: slice) -> None:
