@@ -4,7 +4,13 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from seminspect.core.threads import MAX_SENSOR_THREADS, THREADS_ENV, rotate_rows, sensor_threads
+from seminspect.core.threads import (
+    MAX_SENSOR_THREADS,
+    THREADS_ENV,
+    rotate_rows,
+    sensor_threads,
+    split_range,
+)
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
@@ -43,3 +49,12 @@ def test_sensor_threads_keep_to_the_cores_and_the_settings(monkeypatch):
     assert sensor_threads() == 3
     monkeypatch.setenv(THREADS_ENV, "none")  # not a count: ignored
     assert sensor_threads() == 1
+
+
+def test_split_range_covers_the_range_in_order_or_keeps_it_whole():
+    parts = split_range(10_000, 3, 1000)
+    assert [p.start for p in parts] == [0, *(p.stop for p in parts[:-1])]
+    assert parts[-1].stop == 10_000 and len(parts) == 3
+    assert max(p.stop - p.start for p in parts) - min(p.stop - p.start for p in parts) <= 1
+    assert split_range(1999, 2, 1000) == [slice(0, 1999)]  # under two threads' worth
+    assert split_range(10_000, 1, 1000) == [slice(0, 10_000)]

@@ -9,6 +9,7 @@ multi-threaded one (``tests/core/test_threads.py``).
 
 from __future__ import annotations
 
+import itertools
 import os
 from concurrent.futures import ThreadPoolExecutor
 from functools import cache
@@ -65,3 +66,12 @@ def thread_pool(threads: int) -> ThreadPoolExecutor:
     """One pool of ``threads`` workers per process, shared by the compiled loops that release
     the GIL (ray casting, map updates), so a mission starts its threads once."""
     return ThreadPoolExecutor(threads, thread_name_prefix="seminspect")
+
+
+def split_range(count: int, threads: int, min_per_thread: int) -> list[slice]:
+    """``range(count)`` in contiguous parts, one per thread; one part when a thread would get
+    fewer than ``min_per_thread`` items (below that, splitting costs more than it saves)."""
+    if threads <= 1 or count < 2 * min_per_thread:
+        return [slice(0, count)]
+    bounds = np.linspace(0, count, threads + 1).astype(int)
+    return [slice(int(a), int(b)) for a, b in itertools.pairwise(bounds)]

@@ -24,7 +24,7 @@ from scipy.spatial.transform import Rotation
 
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.params import InspectionParams
-from seminspect.core.threads import rotate_rows
+from seminspect.core.threads import rotate_rows, split_range, thread_pool
 from seminspect.geometry.transforms import Quat, Vec3, as_point, as_quaternion
 from seminspect.sensors.noise import NoiseModel, NormalStream, require_rng
 from seminspect.sensors.shading import OCTAVE_WEIGHTS, OCTAVES, shade_hits, surface_tables
@@ -215,28 +215,37 @@ def render(
     part_id = np.empty(count, dtype=np.int16)
     intensity = np.empty(count, dtype=np.uint8)
     albedo, axes, seed, sun = surface_tables(world)
-    shade_hits(
-        distance,
-        face,
-        directions,
-        cosine,
-        origin,
-        1.0 / model.fx,
-        world.face_instance,
-        world.face_class,
-        world.face_part,
-        albedo,
-        axes,
-        seed,
-        sun,
-        OCTAVES,
-        OCTAVE_WEIGHTS,
-        depth,
-        instance,
-        class_id,
-        part_id,
-        intensity,
-    )
+
+    def shade(part: slice) -> None:
+        shade_hits(
+            distance[part],
+            face[part],
+            directions[part],
+            cosine[part],
+            origin,
+            1.0 / model.fx,
+            world.face_instance,
+            world.face_class,
+            world.face_part,
+            albedo,
+            axes,
+            seed,
+            sun,
+            OCTAVES,
+            OCTAVE_WEIGHTS,
+            depth[part],
+            instance[part],
+            class_id[part],
+            part_id[part],
+            intensity[part],
+        )
+
+    # Pixels shade independently: the calling thread shades the first part, the pool the rest.
+    parts = split_range(count, threads, MIN_PIXELS_PER_THREAD)
+    others = [thread_pool(threads).submit(shade, part) for part in parts[1:]]
+    shade(parts[0])
+    for other in others:
+        other.result()
     shape = (model.height, model.width)
     frame = Frame(
         depth=depth.reshape(shape),
@@ -262,6 +271,8 @@ def render(
 
 
 _SCRATCH = threading.local()
+#: Below this many pixels per thread, splitting the shading costs more than it saves.
+MIN_PIXELS_PER_THREAD = 8192
 #: The dtype of the image noise draw, by ``NoiseModel.image_noise_float32``.
 _DRAW_DTYPE: dict[bool, type[np.float32] | type[np.float64]] = {False: np.float64, True: np.float32}
 
