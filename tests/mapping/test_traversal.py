@@ -6,12 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from seminspect.mapping.traversal import (
-    FREE,
-    MIN_THREADED_RAYS,
-    OCCUPIED,
-    integrate_rays_kernel,
-)
+from seminspect.mapping.traversal import FREE, OCCUPIED, integrate_rays_kernel
 
 
 def _reference_clip(o, d, shape) -> tuple[float, float]:
@@ -126,23 +121,3 @@ def test_walks_started_at_their_end_only_set_their_end_cells() -> None:
     )
     assert states[8, 1, 1] == OCCUPIED and states[6, 2, 2] == FREE
     assert np.count_nonzero(states) == 2
-
-
-@pytest.mark.parametrize("shared_origin", [True, False])
-def test_rays_walked_on_threads_give_the_map_of_one_walk_in_order(shared_origin) -> None:
-    """Interleaved blocks of rays on several threads, end cells occupied after all walks."""
-    rng = np.random.default_rng(7)
-    grid_origin, resolution = np.array([0.0, 0.0, 0.0]), 0.25
-    before = np.zeros((24, 20, 16), dtype=np.uint8)
-    before[rng.random(before.shape) < 0.02] = OCCUPIED
-    before[rng.random(before.shape) < 0.05] = FREE
-    origins, ends, hit = _random_rays(rng, 3 * MIN_THREADED_RAYS, shared_origin)
-    expected = before.copy()
-    _reference(expected, (grid_origin, resolution), origins, ends, hit)
-    for threads in (1, 2, 3):
-        states = before.copy()
-        integrate_rays_kernel(
-            states, grid_origin, resolution, origins, ends, hit, np.zeros(0), threads
-        )
-        np.testing.assert_array_equal(states, expected)
-    assert (expected == OCCUPIED).sum() > (before == OCCUPIED).sum()

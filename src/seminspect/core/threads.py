@@ -64,7 +64,8 @@ def _positive(variable: str) -> int | None:
 @cache
 def thread_pool(threads: int) -> ThreadPoolExecutor:
     """One pool of ``threads`` workers per process, shared by the compiled loops that release
-    the GIL (ray casting, map updates), so a mission starts its threads once."""
+    the GIL (ray casting, shading) and the camera noise drawn ahead, so a mission starts its
+    threads once."""
     return ThreadPoolExecutor(threads, thread_name_prefix="seminspect")
 
 

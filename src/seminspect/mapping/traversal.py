@@ -5,11 +5,6 @@ Each ray is clipped to the grid, then walked cell by cell: every cell it crosses
 the cell holding its end point becomes occupied if the ray hit a surface there. Occupied cells
 stay occupied (a grazing ray never erases a surface another ray saw), which keeps the map
 conservative for planning.
-
-The walks therefore commute: a cell ends occupied if it was or if any ray ends on a surface in
-it, else free if it was or any ray crosses or ends in it. So the rays can be walked on several
-threads at once (they only ever turn unknown cells free), and the occupied end cells set after
-all of them, with the same map as one thread walking them in order.
 """
 
 from __future__ import annotations
@@ -18,8 +13,6 @@ import math
 
 import numba
 import numpy as np
-
-from seminspect.core.threads import thread_pool
 
 UNKNOWN = np.uint8(0)
 FREE = np.uint8(1)
@@ -78,10 +71,9 @@ def _walk(  # noqa: PLR0917 - scalars keep the per-ray walk free of allocations
     dz: float,
     hit: bool,
     t_start: float,
-) -> int:
+) -> None:
     """Free every cell of ``o + t d`` for ``t`` from ``t_start`` (clipped to the grid) to 1;
-    return the flat index of the end cell when the ray hit a surface there (the caller
-    occupies it), else -1.
+    occupy the end cell on a hit.
 
     ``cells`` is the map's C-ordered states, flattened: the walk moves one index by the
     axis strides instead of indexing in 3D, and writes a cell only when it is still unknown
@@ -94,7 +86,7 @@ def _walk(  # noqa: PLR0917 - scalars keep the per-ray walk free of allocations
     t0, t1 = _clip_axis(t0, t1, oy, dy, ny)
     t0, t1 = _clip_axis(t0, t1, oz, dz, nz)
     if t0 > t1:
-        return -1
+        return
     i, j, k = _cell(ox + t0 * dx, nx), _cell(oy + t0 * dy, ny), _cell(oz + t0 * dz, nz)
     li, lj, lk = _cell(ox + t1 * dx, nx), _cell(oy + t1 * dy, ny), _cell(oz + t1 * dz, nz)
     si, mi, di = _start_axis(ox, dx, i)
@@ -124,21 +116,12 @@ def _walk(  # noqa: PLR0917 - scalars keep the per-ray walk free of allocations
         if not inside:
             break
     # The end cell is set even when rounding let the walk slip past it along an edge or corner.
-    if occupy_end:
-        return last
-    if cells[last] == UNKNOWN:
-        cells[last] = FREE
-    return -1
+    if cells[last] != OCCUPIED:
+        cells[last] = OCCUPIED if occupy_end else FREE
 
 
-#: Rays per block handed out to the threads in turn (LiDAR rays come ring by ring, and the
-#: rings' lengths differ: interleaved blocks share the work evenly).
-BLOCK_RAYS = 512
-#: Below this many rays a second thread costs more than it saves.
-MIN_THREADED_RAYS = 2048
-
-
-def integrate_rays_kernel(  # noqa: PLR0917 - the compiled kernels' arguments, passed through
+@numba.njit(cache=True)
+def integrate_rays_kernel(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
     states: np.ndarray,
     grid_origin: np.ndarray,
     resolution: float,
@@ -146,72 +129,30 @@ def integrate_rays_kernel(  # noqa: PLR0917 - the compiled kernels' arguments, p
     ends: np.ndarray,
     hit: np.ndarray,
     carve_from: np.ndarray,
-    threads: int = 1,
 ) -> None:
     """Walk every ray ``origins[r or 0] -> ends[r]`` (world metres) through ``states``.
 
     ``carve_from[r]`` in ``[0, 1]`` is the fraction of ray ``r`` before which it frees nothing
-    (see ``mapping.carving``); an empty array frees every ray from its origin. With
-    ``threads`` > 1 the rays are walked on that many threads; the map is the same.
+    (see ``mapping.carving``); an empty array frees every ray from its origin.
     """
-    count = ends.shape[0]
-    occupy = np.empty(count, dtype=np.int64)
-    arguments = (states, grid_origin, resolution, origins, ends, hit, carve_from, occupy)
-    parts = 1 if count < MIN_THREADED_RAYS else max(1, threads)
-    # The calling thread walks the first part while the pool walks the others.
-    others = [
-        thread_pool(parts).submit(_carve, *arguments, part, parts) for part in range(1, parts)
-    ]
-    _carve(*arguments, 0, parts)
-    for other in others:
-        other.result()
-    _occupy(states, occupy)
-
-
-@numba.njit(cache=True, nogil=True)
-def _carve(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
-    states: np.ndarray,
-    grid_origin: np.ndarray,
-    resolution: float,
-    origins: np.ndarray,
-    ends: np.ndarray,
-    hit: np.ndarray,
-    carve_from: np.ndarray,
-    occupy: np.ndarray,
-    part: int,
-    parts: int,
-) -> None:
-    """Walk the rays of every ``parts``-th block from block ``part``, writing into
-    ``occupy[r]`` the end cell ray ``r`` occupies (-1: none)."""
     thinned = carve_from.shape[0] > 0
     cells = states.reshape(-1)
     shape = states.shape
     shared = origins.shape[0] == 1
-    count = ends.shape[0]
-    for block in range(part * BLOCK_RAYS, count, parts * BLOCK_RAYS):
-        for r in range(block, min(block + BLOCK_RAYS, count)):
-            src = origins[0] if shared else origins[r]
-            ox = (src[0] - grid_origin[0]) / resolution
-            oy = (src[1] - grid_origin[1]) / resolution
-            oz = (src[2] - grid_origin[2]) / resolution
-            occupy[r] = _walk(
-                cells,
-                shape,
-                ox,
-                oy,
-                oz,
-                (ends[r, 0] - grid_origin[0]) / resolution - ox,
-                (ends[r, 1] - grid_origin[1]) / resolution - oy,
-                (ends[r, 2] - grid_origin[2]) / resolution - oz,
-                hit[r],
-                carve_from[r] if thinned else 0.0,
-            )
-
-
-@numba.njit(cache=True)
-def _occupy(states: np.ndarray, occupy: np.ndarray) -> None:
-    """Occupy the end cells of the rays that hit (``occupy[r] >= 0``)."""
-    cells = states.reshape(-1)
-    for index in occupy:
-        if index >= 0:
-            cells[index] = OCCUPIED
+    for r in range(ends.shape[0]):
+        src = origins[0] if shared else origins[r]
+        ox = (src[0] - grid_origin[0]) / resolution
+        oy = (src[1] - grid_origin[1]) / resolution
+        oz = (src[2] - grid_origin[2]) / resolution
+        _walk(
+            cells,
+            shape,
+            ox,
+            oy,
+            oz,
+            (ends[r, 0] - grid_origin[0]) / resolution - ox,
+            (ends[r, 1] - grid_origin[1]) / resolution - oy,
+            (ends[r, 2] - grid_origin[2]) / resolution - oz,
+            hit[r],
+            carve_from[r] if thinned else 0.0,
+        )

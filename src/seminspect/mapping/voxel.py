@@ -177,7 +177,6 @@ class VoxelMap:
         endpoints: ArrayLike,
         hit: ArrayLike,
         carve_from: NDArray[np.float64] | None = None,
-        threads: int = 1,
     ) -> None:
         """Clear the cells along each ray and mark the end cell of every hit occupied.
 
@@ -188,7 +187,6 @@ class VoxelMap:
             hit: ``(N,)`` whether each ray ended on a surface.
             carve_from: ``(N,)`` fraction of each ray before which it frees nothing
                 (thinned carving, ``mapping.carving``); None frees every ray from its origin.
-            threads: walk the rays on this many threads (the same map on any number).
         """
         ends = as_points(endpoints, "ray end points", allow_empty=True)
         start = np.asarray(origins, dtype=np.float64)
@@ -205,7 +203,7 @@ class VoxelMap:
             raise InvalidInputError(f"{starts.size} carving starts for {len(ends)} rays")
         if len(ends):
             integrate_rays_kernel(
-                self.states, self.origin, self.resolution, start, ends, flags, starts, threads
+                self.states, self.origin, self.resolution, start, ends, flags, starts
             )
 
     def integrate_frame(
@@ -214,7 +212,6 @@ class VoxelMap:
         stride: int = 4,
         use_odometry: bool = False,
         carving_spacing: float | None = None,
-        threads: int = 1,
     ) -> None:
         """Integrate every ``stride``-th pixel of a depth frame (rows and columns).
 
@@ -222,7 +219,6 @@ class VoxelMap:
         ``use_odometry`` the rays start from the pose the robot believed it had. With
         ``carving_spacing`` (cells) free space is carved by thinned rays near the camera
         (``mapping.carving``: approximate, faster); None walks every ray from the camera.
-        ``threads``: see :meth:`integrate_rays`.
         """
         if not (isinstance(stride, int) and stride >= 1):
             raise InvalidInputError(f"stride must be a positive integer, got {stride!r}")
@@ -250,14 +246,13 @@ class VoxelMap:
             )
             step = stride / frame.camera.fx
             starts = carving.carve_from(levels, length, step, self.resolution, carving_spacing)
-        self.integrate_rays(position, ends, hit, starts, threads)
+        self.integrate_rays(position, ends, hit, starts)
 
     def integrate_scan(
         self,
         scan: LidarScan,
         clear_misses_to: float | None = None,
         carving_spacing: float | None = None,
-        threads: int = 1,
     ) -> None:
         """Integrate a LiDAR scan: each return clears its ray and marks its end occupied.
 
@@ -266,14 +261,12 @@ class VoxelMap:
         does: open sky and far, empty streets become known free rather than staying unknown.
         With ``carving_spacing`` (cells) free space is carved by thinned beams near the sensor
         (``mapping.carving``, along each ring's columns: approximate, faster).
-        ``threads``: see :meth:`integrate_rays`.
         """
         self.integrate_rays(
             scan.origin,
             scan.points,
             np.ones(len(scan.points), dtype=bool),
             self._thinned_starts(scan.points - scan.origin, carving_spacing),
-            threads,
         )
         if clear_misses_to is None or not len(scan.misses):
             return
@@ -287,7 +280,6 @@ class VoxelMap:
             scan.origin + reaches,
             np.zeros(len(reaches), dtype=bool),
             self._thinned_starts(reaches, carving_spacing),
-            threads,
         )
 
     def _thinned_starts(

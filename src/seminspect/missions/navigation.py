@@ -75,7 +75,6 @@ class Navigator:
             needs this: its LiDAR sees nothing below it, and what it has not seen there (a slab,
             rubble) is what it would fly into. Space above it stays as mapped: the robot climbs
             only along a face it is looking at.
-        threads: threads the map updates walk their rays on (the same map on any number).
     """
 
     def __init__(
@@ -92,11 +91,8 @@ class Navigator:
         timers: Timers | None = None,
         charge_planning_time: bool = False,
         guard_unknown: bool = False,
-        threads: int = 1,
     ) -> None:
         self.timers = timers or Timers()
-        #: Threads the map updates walk their rays on (the same map on any number).
-        self.threads = threads
         self.guard_unknown = guard_unknown
         self.platform = platform
         self.charge_planning_time = charge_planning_time
@@ -127,7 +123,6 @@ class Navigator:
                 self.last_scan,
                 clear_misses_to=self.clear_misses_to,
                 carving_spacing=self.carving_spacing,
-                threads=self.threads,
             )
             if self.guard_unknown:
                 self._clear_body()

@@ -75,7 +75,6 @@ class MissionContext:
                 stride=DEPTH_STRIDE,
                 use_odometry=True,
                 carving_spacing=self.config.map_carving_spacing,
-                threads=self.navigator.threads,
             )
         self.frames_seen += 1
 

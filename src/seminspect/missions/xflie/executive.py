@@ -22,7 +22,6 @@ from __future__ import annotations
 from collections.abc import Callable, Collection
 from dataclasses import dataclass
 
-from seminspect.core.threads import sensor_threads
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.model import TargetNode
 from seminspect.mapping.voxel import VoxelMap
@@ -118,7 +117,6 @@ class XFlie:
             timers=self.recorder.timers,
             charge_planning_time=config.charge_planning_time,
             guard_unknown=config.mode == "aerial",
-            threads=sensor_threads(),
         )
         self.ctx = MissionContext(
             config,
