@@ -5,14 +5,17 @@ and splits its wall time into stages:
 
 * ray casting: ``RayCaster.cast`` (Embree), for camera frames, LiDAR scans and any other query;
 * rendering: what ``render`` does around the rays (shading, labels, intensity texture);
-* noise: the image noise of a frame;
+* noise: the image noise of a frame (where the mission draws it ahead on a worker thread,
+  ``sensors.noise.NormalStream``, the compiled pass and any wait for the draw);
 * map integration: ``integrate_rays_kernel`` (free-space carving and occupied end cells);
 * the mission's own categories for the rest (perception, planning, graph, driving, and
   sensing left after the stages above), and I/O and setup as what no timer covers.
 
 The stages are timed by wrapping those functions for the run only, and charged to the mission's
 own ``Timers`` so that nested time counts once. The figure to drive down is the ratio of the
-total wall time to the ray-casting time (issue 16: <= 2.0).
+total wall time to the ray-casting time (issue 16: <= 2.0). Ray casting is wall time: where a
+mission casts on two threads (``core.threads.sensor_threads``, ``SEMINSPECT_THREADS=1`` for
+one) it counts once, however many cores it kept busy.
 
 ``--float32-image-noise`` runs the mission with ``NoiseModel.image_noise_float32`` on, which
 draws the image noise faster but changes the mission's numbers; the outcome line (detected,

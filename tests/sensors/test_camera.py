@@ -9,7 +9,7 @@ from seminspect.core.params import preset
 from seminspect.core.rng import make_rng
 from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.sensors import CameraModel, NoiseModel, noise_preset, render
-from seminspect.sensors.noise import make_noise
+from seminspect.sensors.noise import NormalStream, make_noise
 from sim_worlds import box_world, car_world
 
 SMALL = CameraModel(width=160, height=120)
@@ -184,3 +184,25 @@ def test_float32_image_noise_is_an_option_with_other_numbers() -> None:
     assert not np.array_equal(frames[0].depth, frames[1].depth)
     assert np.array_equal(np.isfinite(frames[0].depth), np.isfinite(frames[1].depth))
     assert NoiseModel(image_noise_float32=True).is_ideal  # no noise to draw in either dtype
+
+
+def test_a_frame_cast_on_two_threads_is_the_same_frame(wall) -> None:
+    camera = CameraModel()  # 640 x 480: enough rays to split
+    pose = ((0.0, 1.0, 1.5), quat_from_yaw(0.3))
+    noise = noise_preset("realistic")
+    one = render(wall, camera, *pose, noise=noise, rng=make_rng(4, "camera"))
+    two = render(wall, camera, *pose, noise=noise, rng=make_rng(4, "camera"), threads=2)
+    assert np.isfinite(one.depth).any()
+    for name in ("depth", "instance", "class_id", "part_id", "intensity", "face"):
+        np.testing.assert_array_equal(getattr(two, name), getattr(one, name))
+
+
+def test_noise_drawn_ahead_gives_the_same_frames(wall) -> None:
+    noise = noise_preset("realistic")
+    poses = [((0.0, y, 1.5), quat_from_yaw(0.2 * y)) for y in (0.0, 1.0, 2.0)]
+    rng, stream = make_rng(3, "camera"), NormalStream(make_rng(3, "camera"), threads=2)
+    for pose in poses:
+        drawn = render(wall, CameraModel(), *pose, noise=noise, rng=rng)
+        ahead = render(wall, CameraModel(), *pose, noise=noise, rng=stream)
+        np.testing.assert_array_equal(ahead.depth, drawn.depth)
+        np.testing.assert_array_equal(ahead.intensity, drawn.intensity)

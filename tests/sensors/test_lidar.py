@@ -77,3 +77,13 @@ def test_range_noise(room) -> None:
 def test_impossible_lidars_are_refused(kwargs) -> None:
     with pytest.raises(InvalidInputError):
         Lidar(**kwargs)
+
+
+def test_a_scan_cast_on_two_threads_is_the_same_scan(room) -> None:
+    pose = ((0.0, 0.0, 1.0), quat_from_yaw(0.4))
+    noise = make_noise({}, base="realistic")
+    one = Lidar().scan(room, *pose, noise=noise, rng=make_rng(2, "lidar"))
+    two = Lidar().scan(room, *pose, noise=noise, rng=make_rng(2, "lidar"), threads=2)
+    assert len(one.points) > 1000
+    for name in ("points", "instance", "class_id", "part_id", "ring", "misses"):
+        np.testing.assert_array_equal(getattr(two, name), getattr(one, name))

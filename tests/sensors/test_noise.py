@@ -1,8 +1,10 @@
+import numpy as np
 import pytest
 
 from seminspect.core.errors import InvalidInputError, UnknownNameError
+from seminspect.core.rng import make_rng
 from seminspect.sensors import NoiseModel, noise_preset
-from seminspect.sensors.noise import make_noise
+from seminspect.sensors.noise import NormalStream, make_noise
 
 
 def test_presets() -> None:
@@ -46,3 +48,16 @@ def test_formulas() -> None:
 def test_invalid_settings_are_one_line_errors(values) -> None:
     with pytest.raises(InvalidInputError, match="invalid noise setting"):
         make_noise(values)
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_a_normal_stream_gives_the_generators_deviates_in_order(threads, dtype) -> None:
+    sizes = [0, 1, 5000, 9000, 16, 30_000, 3]  # across chunk borders, and one past several
+    expected = make_rng(9, "camera").standard_normal(sum(sizes), dtype=dtype)
+    stream = NormalStream(make_rng(9, "camera"), threads, chunk=4096)
+    taken = np.concatenate([stream.standard_normal(n, dtype=dtype) for n in sizes])
+    assert taken.dtype == dtype
+    np.testing.assert_array_equal(taken, expected)
+    with pytest.raises(InvalidInputError, match="deviates"):
+        stream.standard_normal(3, dtype=np.float16)

@@ -8,6 +8,7 @@ from seminspect.core.rng import make_rng
 from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.sensors import CameraModel, detect, detect_instances, detect_parts, render
 from seminspect.sensors.noise import make_noise
+from seminspect.sensors.segmentation import distinct_positive
 from seminspect.worlds import WorldBuilder
 from seminspect.worlds.shapes import pose_matrix
 from seminspect.worlds.vehicles import vehicle_pieces
@@ -128,3 +129,12 @@ def test_noisy_detection_is_seeded(scene) -> None:
     with pytest.raises(InvalidInputError, match="level"):
         detect(frame, world, "scene")
     assert math.isinf(detect(frame, world, "instance")[0].depth_m) is False
+
+
+def test_distinct_positive_matches_numpy_unique() -> None:
+    rng = np.random.default_rng(5)
+    small = rng.integers(-3, 40, (48, 64))
+    large = np.append(rng.integers(0, 5, 20), 10**9)  # beyond a counting table: sorted instead
+    for values in (small, large, np.zeros((4, 4), dtype=np.int64)):
+        expected = np.unique(values[values > 0])
+        np.testing.assert_array_equal(distinct_positive(values), expected)

@@ -3,6 +3,7 @@ import math
 import numpy as np
 import pytest
 
+from seminspect.core.cache import CACHE_ENV
 from seminspect.core.errors import InvalidInputError
 from sim_worlds import box_world
 
@@ -75,3 +76,29 @@ def test_segments_through_and_beside_an_obstacle(world) -> None:
 def test_bad_queries_are_refused(world, call, message) -> None:
     with pytest.raises(InvalidInputError, match=message):
         call(world)
+
+
+@pytest.mark.parametrize("mode", ["ground", "aerial"])
+def test_a_cached_grid_equals_a_fresh_one(mode, tmp_path, monkeypatch) -> None:
+    monkeypatch.setenv(CACHE_ENV, "off")
+    fresh = box_world().collision.grid(mode)
+    monkeypatch.setenv(CACHE_ENV, str(tmp_path))
+    stored = box_world().collision.grid(mode)  # builds and stores
+    assert len(list((tmp_path / "collision").iterdir())) == 1
+    read = box_world().collision.grid(mode)  # reads back
+    for grid in (stored, read):
+        assert grid.resolution == fresh.resolution
+        np.testing.assert_array_equal(grid.origin, fresh.origin)
+        assert grid.distance.dtype == fresh.distance.dtype
+        np.testing.assert_array_equal(grid.distance, fresh.distance)
+
+
+def test_a_changed_world_misses_the_cache(tmp_path, monkeypatch) -> None:
+    monkeypatch.setenv(CACHE_ENV, str(tmp_path))
+    box_world().collision.grid("ground")
+    taller = box_world(upper=(6.0, 1.0, 2.5)).collision.grid("ground")  # another mesh
+    assert len(list((tmp_path / "collision").iterdir())) == 2
+    monkeypatch.setenv(CACHE_ENV, "off")
+    np.testing.assert_array_equal(
+        taller.distance, box_world(upper=(6.0, 1.0, 2.5)).collision.grid("ground").distance
+    )

@@ -1,4 +1,4 @@
-"""Small matrix products on one BLAS thread.
+"""Small matrix products on one BLAS thread, and how many threads a mission's sensors use.
 
 Rotating a frame's rays is a ``(N, 3) @ (3, 3)`` product: far too little work per row for
 OpenBLAS to gain from its threads, yet it wakes them for every call, and on a busy machine the
@@ -9,6 +9,9 @@ multi-threaded one (``tests/core/test_threads.py``).
 
 from __future__ import annotations
 
+import itertools
+import os
+from concurrent.futures import ThreadPoolExecutor
 from functools import cache
 
 import numpy as np
@@ -30,3 +33,46 @@ def rotate_rows(vectors: NDArray, rotation: NDArray, out: NDArray | None = None)
     """
     with _controller().limit(limits=1, user_api="blas"):
         return np.matmul(np.asarray(vectors), np.asarray(rotation).T, out=out)
+
+
+#: Environment variable that sets :func:`sensor_threads`.
+THREADS_ENV = "SEMINSPECT_THREADS"
+#: Ray casting gains little beyond this many threads per mission.
+MAX_SENSOR_THREADS = 2
+
+
+def sensor_threads() -> int:
+    """Threads one mission's ray casting may use.
+
+    ``$SEMINSPECT_THREADS`` when set; otherwise the cores this process may run on, at most
+    :data:`MAX_SENSOR_THREADS` and at most ``$OMP_NUM_THREADS`` (which Ray sets to a task's
+    CPUs, so the missions of a sweep keep to one thread each). Results never depend on it:
+    every ray is cast on its own, whichever thread casts it.
+    """
+    chosen = _positive(THREADS_ENV)
+    if chosen is not None:
+        return chosen
+    cores = min(MAX_SENSOR_THREADS, len(os.sched_getaffinity(0)))
+    return min(cores, _positive("OMP_NUM_THREADS") or cores)
+
+
+def _positive(variable: str) -> int | None:
+    value = os.environ.get(variable, "").strip()
+    return int(value) if value.isdigit() and int(value) >= 1 else None
+
+
+@cache
+def thread_pool(threads: int) -> ThreadPoolExecutor:
+    """One pool of ``threads`` workers per process, shared by the compiled loops that release
+    the GIL (ray casting, shading) and the camera noise drawn ahead, so a mission starts its
+    threads once."""
+    return ThreadPoolExecutor(threads, thread_name_prefix="seminspect")
+
+
+def split_range(count: int, threads: int, min_per_thread: int) -> list[slice]:
+    """``range(count)`` in contiguous parts, one per thread; one part when a thread would get
+    fewer than ``min_per_thread`` items (below that, splitting costs more than it saves)."""
+    if threads <= 1 or count < 2 * min_per_thread:
+        return [slice(0, count)]
+    bounds = np.linspace(0, count, threads + 1).astype(int)
+    return [slice(int(a), int(b)) for a, b in itertools.pairwise(bounds)]

@@ -23,7 +23,7 @@ from seminspect.geometry.transforms import as_point, wrap_angle
 from seminspect.robot import Robot
 from seminspect.robot.robot import MoveResult
 from seminspect.sensors import CameraModel, Detection, Frame, Lidar, LidarScan, render
-from seminspect.sensors.noise import NoiseModel, make_noise
+from seminspect.sensors.noise import NoiseModel, NormalStream, make_noise
 from seminspect.sensors.segmentation import detect
 from seminspect.worlds import World
 
@@ -121,10 +121,13 @@ class SimulatedPlatform:
         settle_s: float = 0.2,
         capture_s: float = 0.1,
         name: str | None = None,
+        threads: int = 1,
     ) -> None:
         # A named robot (one of a team) draws its noise from streams of its own.
         streams = () if name is None else (name,)
         self.world = world
+        #: Threads the camera and the LiDAR cast their rays on (the same results on any number).
+        self.threads = threads
         self.camera_pitch = camera_pitch
         self.noise = noise
         self.settle_s = settle_s
@@ -143,7 +146,8 @@ class SimulatedPlatform:
             odometry_drift_per_rad=noise.odometry_drift_per_rad,
             rng=make_rng(seed, "robot", "odometry", *streams) if drift else None,
         )
-        self._camera_rng = make_rng(seed, "sensors", "camera", *streams)
+        # The camera's noise is drawn ahead, off the mission's thread (the same numbers).
+        self._camera_rng = NormalStream(make_rng(seed, "sensors", "camera", *streams), threads)
         self._detector_rng = make_rng(seed, "sensors", "segmentation", *streams)
         self._lidar_rng = make_rng(seed, "sensors", "lidar", *streams)
         self.frames = 0
@@ -231,6 +235,7 @@ class SimulatedPlatform:
             rng=self._camera_rng,
             stamp=now.time,
             odometry=(now.odometry_position, self._camera_quaternion(now.odometry_yaw)),
+            threads=self.threads,
         )
         self.robot.wait(self.capture_s)
         self.frames += 1
@@ -266,6 +271,7 @@ class SimulatedPlatform:
             noise=self.noise,
             rng=self._lidar_rng,
             stamp=state.time,
+            threads=self.threads,
         )
         self.scans += 1
         turn = Rotation.from_euler("z", state.odometry_yaw - state.yaw)

@@ -20,6 +20,7 @@ import numpy as np
 
 from seminspect.core.errors import SeminspectError
 from seminspect.core.interrupts import stop_on_signals
+from seminspect.core.threads import sensor_threads
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.mapping.voxel import VoxelMap
 from seminspect.missions.config import MissionConfig, ResolvedMissionConfig, inspects, resolve
@@ -108,6 +109,7 @@ def build_platform(
         body_height=start_height,
         camera_pitch=math.radians(camera_pitch(config)),
         name=name,
+        threads=sensor_threads(),
     )
     return platform, float(platform.position[2] - start_height)
 

@@ -24,9 +24,9 @@ from scipy.spatial.transform import Rotation
 
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.params import InspectionParams
-from seminspect.core.threads import rotate_rows
+from seminspect.core.threads import rotate_rows, split_range, thread_pool
 from seminspect.geometry.transforms import Quat, Vec3, as_point, as_quaternion
-from seminspect.sensors.noise import NoiseModel, require_rng
+from seminspect.sensors.noise import NoiseModel, NormalStream, require_rng
 from seminspect.sensors.shading import OCTAVE_WEIGHTS, OCTAVES, shade_hits, surface_tables
 from seminspect.worlds import World
 
@@ -177,19 +177,22 @@ def render(
     orientation: ArrayLike,
     *,
     noise: NoiseModel | None = None,
-    rng: np.random.Generator | None = None,
+    rng: np.random.Generator | NormalStream | None = None,
     stamp: float = 0.0,
     stride: int = 1,
     odometry: tuple[ArrayLike, ArrayLike] | None = None,
+    threads: int = 1,
 ) -> Frame:
     """Render a frame of ``world`` from the camera pose ``(position, orientation [x,y,z,w])``.
 
     Args:
         noise: depth and intensity noise (``None``: ideal).
-        rng: generator for the noise; required when the noise model is not ideal.
+        rng: generator for the noise, required when the noise model is not ideal; or a
+            :class:`NormalStream` of its deviates drawn ahead (the same frame).
         stamp: time the frame is tagged with.
         stride: render every ``stride``-th pixel (see :meth:`CameraModel.scaled`).
         odometry: the ``(position, orientation)`` the robot believed it had at ``stamp``.
+        threads: cast the rays on this many threads (the same frame on any number).
     """
     origin = as_point(position, "camera position")
     quat = as_quaternion(orientation, "camera orientation")
@@ -200,7 +203,11 @@ def render(
     rotation = Rotation.from_quat(quat).as_matrix().astype(np.float32)
     rotate_rows(directions_body, rotation, out=directions)
     distance, face = world.raycaster.cast(
-        origin, directions, model.ray_limits, out=(distance, np.empty(count, dtype=np.int32))
+        origin,
+        directions,
+        model.ray_limits,
+        threads,
+        out=(distance, np.empty(count, dtype=np.int32)),
     )
     depth = np.empty(count, dtype=np.float32)
     instance = np.empty(count, dtype=np.int32)
@@ -208,28 +215,37 @@ def render(
     part_id = np.empty(count, dtype=np.int16)
     intensity = np.empty(count, dtype=np.uint8)
     albedo, axes, seed, sun = surface_tables(world)
-    shade_hits(
-        distance,
-        face,
-        directions,
-        cosine,
-        origin,
-        1.0 / model.fx,
-        world.face_instance,
-        world.face_class,
-        world.face_part,
-        albedo,
-        axes,
-        seed,
-        sun,
-        OCTAVES,
-        OCTAVE_WEIGHTS,
-        depth,
-        instance,
-        class_id,
-        part_id,
-        intensity,
-    )
+
+    def shade(part: slice) -> None:
+        shade_hits(
+            distance[part],
+            face[part],
+            directions[part],
+            cosine[part],
+            origin,
+            1.0 / model.fx,
+            world.face_instance,
+            world.face_class,
+            world.face_part,
+            albedo,
+            axes,
+            seed,
+            sun,
+            OCTAVES,
+            OCTAVE_WEIGHTS,
+            depth[part],
+            instance[part],
+            class_id[part],
+            part_id[part],
+            intensity[part],
+        )
+
+    # Pixels shade independently: the calling thread shades the first part, the pool the rest.
+    parts = split_range(count, threads, MIN_PIXELS_PER_THREAD)
+    others = [thread_pool(threads).submit(shade, part) for part in parts[1:]]
+    shade(parts[0])
+    for other in others:
+        other.result()
     shape = (model.height, model.width)
     frame = Frame(
         depth=depth.reshape(shape),
@@ -250,11 +266,13 @@ def render(
         else as_quaternion(odometry[1], "odometry orientation"),
     )
     if noise is not None and not noise.is_ideal:
-        _add_image_noise(frame, noise, require_rng(rng))
+        _add_image_noise(frame, noise, rng if isinstance(rng, NormalStream) else require_rng(rng))
     return frame
 
 
 _SCRATCH = threading.local()
+#: Below this many pixels per thread, splitting the shading costs more than it saves.
+MIN_PIXELS_PER_THREAD = 8192
 #: The dtype of the image noise draw, by ``NoiseModel.image_noise_float32``.
 _DRAW_DTYPE: dict[bool, type[np.float32] | type[np.float64]] = {False: np.float64, True: np.float32}
 
@@ -274,7 +292,9 @@ def _scratch(count: int) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
     return buffers
 
 
-def _add_image_noise(frame: Frame, noise: NoiseModel, rng: np.random.Generator) -> None:
+def _add_image_noise(
+    frame: Frame, noise: NoiseModel, rng: np.random.Generator | NormalStream
+) -> None:
     """Depth noise with a range-dependent sigma, and pixel noise on the intensity image.
 
     All the normal deviates come from one draw: the hit pixels' depth noise first (row-major),

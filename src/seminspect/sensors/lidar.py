@@ -99,13 +99,15 @@ class Lidar:
         noise: NoiseModel | None = None,
         rng: np.random.Generator | None = None,
         stamp: float = 0.0,
+        threads: int = 1,
     ) -> LidarScan:
-        """Cast every beam from the pose ``(position, orientation [x, y, z, w])``."""
+        """Cast every beam from the pose ``(position, orientation [x, y, z, w])``, on
+        ``threads`` threads (the same scan on any number)."""
         origin = as_point(position, "LiDAR position")
         rotation = Rotation.from_quat(as_quaternion(orientation, "LiDAR orientation"))
         body, ring = self.rays
         directions = rotate_rows(body, rotation.as_matrix().astype(np.float32))
-        distance, face = world.raycaster.cast(origin, directions, self.max_range)
+        distance, face = world.raycaster.cast(origin, directions, self.max_range, threads)
         hit = face >= 0
         ranges = distance[hit].astype(np.float64)
         if noise is not None and noise.lidar_range_noise_m:

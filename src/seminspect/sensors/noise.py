@@ -19,12 +19,15 @@ travelled and the angle turned, so splitting a motion into pieces does not chang
 from __future__ import annotations
 
 import math
+from concurrent.futures import Future
 
 import numpy as np
+from numpy.typing import DTypeLike, NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.names import unknown_name
+from seminspect.core.threads import thread_pool
 
 
 class NoiseModel(BaseModel):
@@ -115,6 +118,58 @@ class NoiseModel(BaseModel):
     def is_ideal(self) -> bool:
         """Whether this model changes nothing (no random draws are needed)."""
         return self.model_copy(update={"image_noise_float32": False}) == NoiseModel()
+
+
+class NormalStream:
+    """The standard normal deviates of one generator, in its order, drawn ahead on a thread.
+
+    numpy's generators give the same deviates whatever the sizes they are drawn in (``n``
+    then ``m`` equal one draw of ``n + m``), so while a mission does other work a worker
+    thread draws the next ``chunk`` and :meth:`standard_normal` hands them out: the numbers
+    of drawing each frame's noise when it is needed, off the mission's own thread. The
+    generator must not be drawn from elsewhere once the stream has it.
+
+    Args:
+        rng: the generator (the stream owns it from now on).
+        threads: the pool to draw on (``core.threads.thread_pool``); 1 draws in the caller.
+        chunk: deviates drawn at a time.
+    """
+
+    def __init__(self, rng: np.random.Generator, threads: int, chunk: int = 1 << 20) -> None:
+        self._rng = rng
+        self._threads = threads
+        self._chunk = chunk
+        self._dtype: np.dtype | None = None
+        self._buffer = np.empty(0)
+        self._ahead: Future[NDArray] | None = None
+
+    def standard_normal(self, size: int, dtype: DTypeLike = np.float64) -> NDArray:
+        """The next ``size`` deviates, as ``Generator.standard_normal(size, dtype)`` gives them
+        (every call with the same ``dtype``)."""
+        wanted = np.dtype(dtype)
+        if self._dtype is None:
+            self._dtype = wanted
+            self._buffer = np.empty(0, dtype=wanted)
+        elif wanted != self._dtype:
+            raise InvalidInputError(f"a stream of {self._dtype} deviates cannot give {wanted}")
+        pieces = []
+        while size > len(self._buffer):
+            pieces.append(self._buffer)
+            size -= len(self._buffer)
+            self._buffer = self._next_chunk()
+        pieces.append(self._buffer[:size])
+        self._buffer = self._buffer[size:]
+        return pieces[0] if len(pieces) == 1 else np.concatenate(pieces)
+
+    def _next_chunk(self) -> NDArray:
+        """The chunk drawn ahead (or, the first time or on one thread, drawn now), and the
+        next one started."""
+        chunk = self._ahead.result() if self._ahead is not None else self._draw()
+        self._ahead = thread_pool(self._threads).submit(self._draw) if self._threads > 1 else None
+        return chunk
+
+    def _draw(self) -> NDArray:
+        return self._rng.standard_normal(self._chunk, dtype=self._dtype)  # type: ignore[arg-type]
 
 
 def require_rng(rng: np.random.Generator | None) -> np.random.Generator:

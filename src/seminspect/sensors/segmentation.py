@@ -79,6 +79,18 @@ def _distort(mask: NDArray[np.bool_], background: NDArray[np.bool_], noise: Nois
     return shaped.astype(bool)
 
 
+def distinct_positive(values: NDArray[np.int64]) -> NDArray[np.int64]:
+    """The distinct values above 0, ascending (``np.unique(values[values > 0])``).
+
+    Counting into a table is several times faster than numpy's unique on a frame's
+    300,000 pixel keys; values too large for a small table fall back to sorting.
+    """
+    positive = values[values > 0]
+    if positive.size and positive.max() <= 4 * values.size:
+        return np.flatnonzero(np.bincount(positive))
+    return np.unique(positive)
+
+
 def _keys(frame: Frame, world: World, level: Level, classes, parts) -> tuple[NDArray, list]:
     """Per-pixel grouping key and the (key, label, instance) of every candidate.
 
@@ -94,7 +106,7 @@ def _keys(frame: Frame, world: World, level: Level, classes, parts) -> tuple[NDA
         key = frame.instance.astype(np.int64) * stride + frame.part_id
         key[frame.part_id == 0] = 0
     candidates = []
-    for value in np.unique(key[key > 0]).tolist():
+    for value in distinct_positive(key).tolist():
         inst = value if level == "instance" else value // stride
         info = world.instances.get(inst)
         if info is None or (wanted is not None and info.class_name not in wanted):

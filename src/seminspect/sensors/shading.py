@@ -44,7 +44,7 @@ def _hash(ix: int, iy: int, seed: int) -> float:
     return (h & 0xFFFFFF) / 16777216.0
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def shade_hits(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
     distance: np.ndarray,
     face: np.ndarray,

@@ -17,21 +17,29 @@ within ``D(c) - r*sqrt(d)`` and ``D(c) + r*sqrt(d)`` (grid resolution ``r``, dim
 :meth:`CollisionField.clearance` returns the lower bound, so ``is_free`` never accepts a point
 closer than ``radius`` to a surface; it underestimates by at most ``2*r*sqrt(d)``: 0.14 m in the
 0.05 m ground grid, 0.35 m in a 0.1 m aerial grid and 0.69 m in the city's 0.2 m aerial grid.
+
+Each grid's distances are kept in the on-disk cache (``core.cache``) under a hash of the mesh,
+the grid's parameters and this module's code: the next mission on the same world reads them
+back instead of spending seconds on the rasterisation and the distance transform.
 """
 
 from __future__ import annotations
 
 import math
+import sys
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Literal
 
 import numpy as np
+import scipy
 from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 
+from seminspect.core.cache import array_key, cached_array, source_digest
 from seminspect.core.errors import InvalidInputError
-from seminspect.geometry.raster import cells_touching_triangles
+from seminspect.geometry import raster
 from seminspect.geometry.transforms import as_point, as_points
 
 CollisionMode = Literal["ground", "aerial"]
@@ -88,7 +96,9 @@ def _solid_cells(
 ) -> NDArray[np.bool_]:
     """Cells touching a triangle, plus the enclosed inside of every object (instance > 0)."""
     nx, ny, nz = shape  # a 3D grid
-    occupied = cells_touching_triangles(triangles[face_instance == 0], origin, cell, (nx, ny, nz))
+    occupied = raster.cells_touching_triangles(
+        triangles[face_instance == 0], origin, cell, (nx, ny, nz)
+    )
     order = np.argsort(face_instance, kind="stable")
     ids, starts = np.unique(face_instance[order], return_index=True)
     for inst, lo, hi in zip(ids, starts, np.append(starts[1:], len(order)), strict=True):
@@ -100,18 +110,20 @@ def _solid_cells(
         first, last = np.maximum(first, 0), np.minimum(last, shape)
         if np.any(last <= first):
             continue
-        local = cells_touching_triangles(own, origin + first * cell, cell, tuple(last - first))
+        local = raster.cells_touching_triangles(
+            own, origin + first * cell, cell, tuple(last - first)
+        )
         window = tuple(slice(a, b) for a, b in zip(first, last, strict=True))
         occupied[window] |= ndimage.binary_fill_holes(local)
     return occupied
 
 
-def _distance_grid(occupied: NDArray[np.bool_], origin: NDArray, resolution: float) -> DistanceGrid:
+def _distances(occupied: NDArray[np.bool_], resolution: float) -> NDArray[np.float32]:
     if occupied.any():
         distance = ndimage.distance_transform_edt(~occupied, sampling=resolution)
     else:  # nothing to hit: every cell is as far as the grid is wide
         distance = np.full(occupied.shape, resolution * max(occupied.shape))
-    return DistanceGrid(origin, resolution, distance.astype(np.float32))
+    return distance.astype(np.float32)
 
 
 def space_resolution(bounds: NDArray[np.float64], max_cells: int = MAX_SPACE_CELLS) -> float:
@@ -168,14 +180,18 @@ class CollisionField:
         origin = np.array([self.bounds[0, 0], self.bounds[0, 1], low])
         shape = (*_cells(self.bounds[:, :2], res), 1)
         keep = ~self._is_ground
-        occupied = _solid_cells(
-            self._triangles[keep],
-            self._face_instance[keep],
-            origin,
-            np.array([res, res, high - low]),
-            shape,
-        )
-        return _distance_grid(occupied[:, :, 0], origin, res)
+
+        def build() -> NDArray[np.float32]:
+            occupied = _solid_cells(
+                self._triangles[keep],
+                self._face_instance[keep],
+                origin,
+                np.array([res, res, high - low]),
+                shape,
+            )
+            return _distances(occupied[:, :, 0], res)
+
+        return DistanceGrid(origin, res, self._cached("ground", build, keep, origin, shape))
 
     @cached_property
     def aerial(self) -> DistanceGrid:
@@ -184,8 +200,33 @@ class CollisionField:
         origin = self.bounds[0].copy()
         shape = _cells(self.bounds, res)
         cell = np.full(3, res)
-        occupied = _solid_cells(self._triangles, self._face_instance, origin, cell, shape)
-        return _distance_grid(occupied, origin, res)
+
+        def build() -> NDArray[np.float32]:
+            occupied = _solid_cells(self._triangles, self._face_instance, origin, cell, shape)
+            return _distances(occupied, res)
+
+        return DistanceGrid(origin, res, self._cached("aerial", build, origin, shape))
+
+    def _cached(
+        self, mode: CollisionMode, build: Callable[[], NDArray[np.float32]], *inputs: object
+    ) -> NDArray[np.float32]:
+        """``build()``'s distances, from the on-disk cache when this mesh's grid is there.
+
+        The key holds the mesh, the grid's parameters and the source of the code that builds
+        it, so any change to them builds afresh (``core.cache``).
+        """
+        key = array_key(
+            mode,
+            self._triangles,
+            self._face_instance,
+            self.bounds,
+            self.ground_z,
+            self.band,
+            *inputs,
+            source_digest(sys.modules[__name__], raster),
+            scipy.__version__,
+        )
+        return cached_array("collision", key, build)
 
     def grid(self, mode: CollisionMode) -> DistanceGrid:
         if mode == "ground":

@@ -10,9 +10,6 @@ loop is the fallback where its library cannot be loaded, with the same hits.
 
 from __future__ import annotations
 
-import itertools
-from concurrent.futures import ThreadPoolExecutor
-from functools import cache
 from typing import NamedTuple
 
 import numpy as np
@@ -21,6 +18,7 @@ from embreex.mesh_construction import TriangleMesh
 from numpy.typing import ArrayLike, NDArray
 
 from seminspect.core.errors import InvalidInputError
+from seminspect.core.threads import split_range, thread_pool
 from seminspect.worlds.embree import MAX_TFAR, EmbreeScene, cast_rays, embree_library
 
 #: Embree's "no hit" primitive id.
@@ -93,12 +91,13 @@ class RayCaster:
             raise InvalidInputError(f"max_range must be one value or {count}, got {limit.shape}")
         distance, face = _outputs(count, out)
         batch = _Batch(starts, dirs, limit, distance, face)
-        parts = _parts(count, threads)
+        parts = split_range(count, threads, MIN_RAYS_PER_THREAD)
         cast_part = self._cast_compiled if self._compiled is not None else self._cast_embreex
-        if len(parts) == 1:
-            cast_part(batch, parts[0])
-        else:
-            list(_pool(threads).map(lambda part: cast_part(batch, part), parts))
+        # The calling thread casts the first part while the pool casts the others.
+        others = [thread_pool(threads).submit(cast_part, batch, part) for part in parts[1:]]
+        cast_part(batch, parts[0])
+        for other in others:
+            other.result()
         return batch.distance, batch.face
 
     def _cast_compiled(self, batch: _Batch, part: slice) -> None:
@@ -146,16 +145,3 @@ def _outputs(
         if array.shape != (count,) or array.dtype != dtype or not array.flags.c_contiguous:
             raise InvalidInputError(f"cast outputs must be contiguous ({count},) {dtype.__name__}")
     return distance, face
-
-
-def _parts(count: int, threads: int) -> list[slice]:
-    """Contiguous ray ranges, one per thread; one range below the split's break-even."""
-    if threads <= 1 or count < 2 * MIN_RAYS_PER_THREAD:
-        return [slice(0, count)]
-    bounds = np.linspace(0, count, threads + 1).astype(int)
-    return [slice(int(a), int(b)) for a, b in itertools.pairwise(bounds)]
-
-
-@cache
-def _pool(threads: int) -> ThreadPoolExecutor:
-    return ThreadPoolExecutor(threads, thread_name_prefix="embree")

@@ -9,6 +9,7 @@ from seminspect.missions.xflie.surface import (
     MIN_VIEW_STEP,
     PointSet,
     SurfaceTracker,
+    first_of_each_row,
 )
 from seminspect.perception.observation import Observation
 from seminspect.planning.view_planner import ViewConstraints
@@ -52,6 +53,15 @@ def test_adding_views_keeps_the_first_point_of_each_voxel_in_order() -> None:
     _, first = np.unique(np.floor(everything / 0.2).astype(np.int64), axis=0, return_index=True)
     np.testing.assert_array_equal(grown.points, everything[np.sort(first)])
     assert 0 < grown.size < len(everything)
+
+
+def test_first_of_each_row_matches_numpy_unique_on_rows() -> None:
+    rng = np.random.default_rng(3)
+    for low, high, n in ((-5, 5, 400), (-1, 1, 50), (10**6, 10**6 + 3, 30), (0, 1, 1)):
+        cells = rng.integers(low, high, (n, 3))
+        _, first = np.unique(cells, axis=0, return_index=True)
+        np.testing.assert_array_equal(first_of_each_row(cells), np.sort(first))
+    assert first_of_each_row(np.empty((0, 3), dtype=np.int64)).size == 0
 
 
 def test_lidar_returns_attached_to_the_target_join_its_surface() -> None:

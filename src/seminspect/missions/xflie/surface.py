@@ -53,9 +53,8 @@ class PointSet:
         """Keep each point whose voxel holds none yet, in order. Only the new points are
         sorted: deduplicating the whole, growing set on every view cost seconds a mission."""
         cells = np.floor(points / self.voxel).astype(np.int64)
-        _, first = np.unique(cells, axis=0, return_index=True)
         fresh = []
-        for index in np.sort(first).tolist():
+        for index in first_of_each_row(cells).tolist():
             cell = tuple(cells[index].tolist())
             if cell not in self._voxels:
                 self._voxels.add(cell)
@@ -70,6 +69,22 @@ class PointSet:
             self._tree = cKDTree(self.points)
         distance, _ = self._tree.query(points, distance_upper_bound=radius)
         return np.isfinite(distance)
+
+
+def first_of_each_row(cells: NDArray[np.int64]) -> NDArray[np.intp]:
+    """Index of the first occurrence of each distinct row of ``cells`` (``(N, 3)``), ascending.
+
+    The same as ``np.sort(np.unique(cells, axis=0, return_index=True)[1])``, about ten times
+    faster: each row becomes one integer key within the rows' bounding box, and sorting keys
+    is cheaper than sorting rows. The box must hold fewer cells than ``intp`` counts (true of
+    any voxels of a world; numpy raises otherwise).
+    """
+    if not len(cells):
+        return np.empty(0, dtype=np.intp)
+    offset = cells - cells.min(axis=0)
+    keys = np.ravel_multi_index(tuple(offset.T), tuple(offset.max(axis=0) + 1))
+    _, first = np.unique(keys, return_index=True)
+    return np.sort(first)
 
 
 class SurfaceTracker:

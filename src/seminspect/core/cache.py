@@ -1,0 +1,79 @@
+"""An on-disk cache of arrays that are slow to compute and fully determined by their inputs.
+
+A world's collision grids take seconds to build and are rebuilt by every mission on the same
+world; here they are stored once, under a key that hashes everything they are computed from,
+and read back in milliseconds. A changed input gives another key, so a stale array is never
+read: callers put into the key every input array and parameter, and the source of the code
+that computes it (:func:`source_digest`).
+
+The cache lives in ``$SEMINSPECT_CACHE_DIR``, else ``$XDG_CACHE_HOME/seminspect``, else
+``~/.cache/seminspect``; ``SEMINSPECT_CACHE_DIR=off`` turns it off. Files are written
+atomically (``core.io``); a cache that cannot be read or written only costs the rebuild.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from collections.abc import Callable
+from pathlib import Path
+from types import ModuleType
+
+import numpy as np
+from numpy.typing import NDArray
+
+from seminspect.core.io import atomic_output
+
+#: Environment variable naming the cache folder (``off``: no cache).
+CACHE_ENV = "SEMINSPECT_CACHE_DIR"
+
+
+def cache_dir() -> Path | None:
+    """The cache folder, or None when the cache is off."""
+    chosen = os.environ.get(CACHE_ENV)
+    if chosen == "off":
+        return None
+    if chosen:
+        return Path(chosen)
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "seminspect"
+
+
+def source_digest(*modules: ModuleType) -> str:
+    """Hash of the modules' source files: a key part that changes whenever their code does."""
+    digest = hashlib.blake2b(digest_size=16)
+    for module in modules:
+        digest.update(Path(str(module.__file__)).read_bytes())
+    return digest.hexdigest()
+
+
+def array_key(*parts: object) -> str:
+    """Hash of arrays (dtype, shape and bytes) and other values (their ``repr``)."""
+    digest = hashlib.blake2b(digest_size=20)
+    for part in parts:
+        if isinstance(part, np.ndarray):
+            digest.update(f"{part.dtype.str}{part.shape}".encode())
+            digest.update(np.ascontiguousarray(part).tobytes())
+        else:
+            digest.update(repr(part).encode())
+        digest.update(b"\0")
+    return digest.hexdigest()
+
+
+def cached_array(kind: str, key: str, build: Callable[[], NDArray]) -> NDArray:
+    """The array stored under ``kind/key``, or ``build()``'s result, stored for next time."""
+    folder = cache_dir()
+    if folder is None:
+        return build()
+    path = folder / kind / f"{key}.npy"
+    try:
+        return np.load(path, allow_pickle=False)
+    except (OSError, ValueError):  # absent, unreadable or torn by another writer's crash
+        pass
+    array = build()
+    try:
+        with atomic_output(path) as temporary:
+            np.save(temporary, array, allow_pickle=False)
+    except OSError:  # a read-only or full disk: the array is still good
+        pass
+    return array
