@@ -1,8 +1,11 @@
+import os
+
 import numpy as np
 import pytest
 
 from seminspect.core import cache
 from seminspect.core.cache import CACHE_ENV, array_key, cache_dir, cached_array
+from seminspect.core.errors import InvalidInputError
 
 
 @pytest.fixture
@@ -93,3 +96,35 @@ def test_keys_change_with_any_input() -> None:
 def test_source_digest_follows_the_code() -> None:
     assert cache.source_digest(cache) == cache.source_digest(cache)
     assert cache.source_digest(cache) != cache.source_digest(np)
+
+
+def test_the_least_recently_used_files_go_first_when_the_cache_is_full(folder) -> None:
+    build, _ = counting_build(1.0)  # 3 x 4 float32: 176 bytes on disk with the .npy header
+    for key in ("old", "used", "new"):
+        cached_array("grids", key, build)
+    grids = folder / "grids"
+    for age, key in enumerate(("new", "used", "old")):
+        stamp = 1_000_000 - 100 * age
+        os.utime(grids / f"{key}.npy", (stamp, stamp))
+    cached_array("grids", "used", build)  # a read marks it as the most recent use
+    size = (grids / "new.npy").stat().st_size
+    deleted = cache.evict_least_recent(folder, 2 * size)
+    assert deleted == [grids / "old.npy"]
+    assert sorted(p.name for p in grids.iterdir()) == ["new.npy", "used.npy"]
+
+
+def test_a_store_keeps_the_folder_under_its_bound(folder, monkeypatch) -> None:
+    build, _ = counting_build(2.0)
+    cached_array("grids", "first", build)
+    size = (folder / "grids" / "first.npy").stat().st_size
+    monkeypatch.setenv(cache.CACHE_MAX_ENV, str(1.5 * size / 2**20))
+    os.utime(folder / "grids" / "first.npy", (1_000_000, 1_000_000))
+    cached_array("grids", "second", build)
+    assert [p.name for p in (folder / "grids").iterdir()] == ["second.npy"]
+
+
+@pytest.mark.parametrize("value", ["lots", "-5", "nan", "inf"])
+def test_an_impossible_bound_is_a_clear_error(monkeypatch, value) -> None:
+    monkeypatch.setenv(cache.CACHE_MAX_ENV, value)
+    with pytest.raises(InvalidInputError, match=cache.CACHE_MAX_ENV):
+        cache.cache_limit_bytes()

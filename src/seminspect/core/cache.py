@@ -8,24 +8,33 @@ that computes it (:func:`source_digest`).
 
 The cache lives in ``$SEMINSPECT_CACHE_DIR``, else ``$XDG_CACHE_HOME/seminspect``, else
 ``~/.cache/seminspect``; ``SEMINSPECT_CACHE_DIR=off`` turns it off. Files are written
-atomically (``core.io``); a cache that cannot be read or written only costs the rebuild.
+atomically (``core.io``); a cache that cannot be read or written only costs the rebuild. The
+folder is kept under ``$SEMINSPECT_CACHE_MAX_MB`` (default 2,048 MB): after each store the files
+used least recently (a read counts as a use) are deleted until it fits.
 """
 
 from __future__ import annotations
 
 import hashlib
+import math
 import os
 from collections.abc import Callable
+from contextlib import suppress
 from pathlib import Path
 from types import ModuleType
 
 import numpy as np
 from numpy.typing import NDArray
 
+from seminspect.core.errors import InvalidInputError
 from seminspect.core.io import atomic_output
 
 #: Environment variable naming the cache folder (``off``: no cache).
 CACHE_ENV = "SEMINSPECT_CACHE_DIR"
+#: Environment variable bounding the cache folder's size, in megabytes.
+CACHE_MAX_ENV = "SEMINSPECT_CACHE_MAX_MB"
+#: The bound when ``CACHE_MAX_ENV`` is unset: a city world's grids take about 24 MB.
+DEFAULT_CACHE_MAX_MB = 2048
 
 
 def cache_dir() -> Path | None:
@@ -37,6 +46,20 @@ def cache_dir() -> Path | None:
         return Path(chosen)
     base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
     return Path(base) / "seminspect"
+
+
+def cache_limit_bytes() -> int:
+    """The most bytes the cache folder may hold (``CACHE_MAX_ENV``, else the default)."""
+    chosen = os.environ.get(CACHE_MAX_ENV, "")
+    try:
+        megabytes = float(chosen) if chosen else DEFAULT_CACHE_MAX_MB
+    except ValueError:
+        megabytes = math.nan
+    if not (math.isfinite(megabytes) and megabytes >= 0):
+        raise InvalidInputError(
+            f"{CACHE_MAX_ENV} must be a number of megabytes >= 0, not {chosen!r}"
+        )
+    return int(megabytes * 2**20)
 
 
 def source_digest(*modules: ModuleType) -> str:
@@ -67,13 +90,36 @@ def cached_array(kind: str, key: str, build: Callable[[], NDArray]) -> NDArray:
         return build()
     path = folder / kind / f"{key}.npy"
     try:
-        return np.load(path, allow_pickle=False)
+        array = np.load(path, allow_pickle=False)
+        os.utime(path)  # a use: eviction goes by last use
+        return array
     except (OSError, ValueError):  # absent, unreadable or torn by another writer's crash
         pass
     array = build()
     try:
         with atomic_output(path) as temporary:
             np.save(temporary, array, allow_pickle=False)
+        evict_least_recent(folder, cache_limit_bytes())
     except OSError:  # a read-only or full disk: the array is still good
         pass
     return array
+
+
+def evict_least_recent(folder: Path, limit_bytes: int) -> list[Path]:
+    """Delete the cache's least recently used files until the folder holds at most
+    ``limit_bytes``; returns the files deleted."""
+    entries = []
+    for path in folder.rglob("*.npy"):
+        with suppress(OSError):  # another process may delete it meanwhile
+            stat = path.stat()
+            entries.append((stat.st_mtime, stat.st_size, path))
+    total = sum(size for _, size, _ in entries)
+    deleted = []
+    for _, size, path in sorted(entries, key=lambda entry: entry[0]):
+        if total <= limit_bytes:
+            break
+        with suppress(OSError):
+            path.unlink()
+            deleted.append(path)
+        total -= size
+    return deleted
