@@ -151,3 +151,12 @@ def test_a_robot_at_its_targets_entry_height_does_not_descend() -> None:
     building = inspected_in_two_levels(ctx)
     approach(ctx).descend(building)
     assert np.allclose(ctx.platform.position, [0.0, 4.0, 2.0]) and "descended" not in events.kinds()
+
+
+def test_an_aerial_robot_takes_a_graph_leg_only_to_a_node_at_its_height() -> None:
+    ctx, _ = fake_context(FakePlatform(position=(0.0, 0.0, 2.0)), settings={"mode": "aerial"})
+    inspected_in_two_levels(ctx)
+    approach(ctx).graph_leg(np.array([-2.0, 9.5, 3.5]))  # nearest node: Level-1's start
+    assert np.allclose(ctx.platform.position, [0.0, 0.0, 2.0]) and not ctx.recorder.plans
+    approach(ctx).graph_leg(np.array([-2.0, 9.5, 2.0]))  # nearest node: a Level-0 pose
+    assert np.allclose(ctx.platform.position, [-2.0, 6.0, 2.0]) and ctx.recorder.plans

@@ -7,7 +7,8 @@ straight); the rest is planned on the robot's own occupancy map into unknown spa
 baseline) the volumetric planner plans the whole way instead.
 
 Aerial robots travel between targets at the height they fly (level with the robot, on a band of
-the map, so a route cannot climb over a roof to meet ``ε`` from above), and leave an inspected
+the map, so a route cannot climb over a roof to meet ``ε`` from above; a graph leg only to a
+node at that height, as their graph holds every level's poses), and leave an inspected
 target the way they climbed it (:meth:`Approach.descend`): every target's ``Level-0`` then
 starts at the first level's height, as the first target's does.
 """
@@ -54,8 +55,9 @@ ARRIVAL_FALLBACKS = (0.0, 1.0, 2.5)
 CONFIRM_OFFSETS = (0.0, math.radians(35), -math.radians(35))
 #: The graph leg is skipped unless it ends this much closer to the goal than the robot is [m].
 GRAPH_LEG_GAIN = 5.0
-#: An aerial robot this far above an inspected target's ``Level-0`` flies back down to it [m].
-DESCENT_MIN = 0.5
+#: Heights this close count as one flight level [m]: an aerial robot higher than its target's
+#: ``Level-0`` by more flies back down to it, and takes no graph leg to a node off its level.
+FLIGHT_LEVEL_TOLERANCE = 0.5
 
 
 class Approach:
@@ -125,7 +127,7 @@ class Approach:
         """
         ctx = self.ctx
         entry = LayeredSemanticGraph.entry_level(target)
-        if ctx.platform.position[2] - entry.position[2] < DESCENT_MIN:
+        if ctx.platform.position[2] - entry.position[2] < FLIGHT_LEVEL_TOLERANCE:
             return
         with ctx.timers("planning"):
             try:
@@ -142,6 +144,12 @@ class Approach:
             height=round(float(ctx.platform.position[2]), 2),
         )
 
+    def on_flight_level(self, point: NDArray[np.float64]) -> bool:
+        """Whether ``point`` lies at the height an aerial robot flies (ground robots: always)."""
+        ctx = self.ctx
+        height = abs(point[2] - ctx.platform.position[2])
+        return ctx.config.mode != "aerial" or height <= FLIGHT_LEVEL_TOLERANCE
+
     def graph_leg(self, goal: NDArray[np.float64]) -> None:
         """The known part of the route: over the 3DLSG to the traversable node nearest ``goal``."""
         ctx = self.ctx
@@ -155,6 +163,8 @@ class Approach:
                 (goal - here)[:2]
             ):
                 return  # the graph gets the robot no closer than driving straight for it
+            if not self.on_flight_level(entry_position):
+                return  # an aerial robot's graph holds every level's poses: it travels level
             try:
                 plan = self.planner.plan(entry, here)
             except PlanningError:  # the Target layer does not join the two; drive without it
