@@ -3,14 +3,14 @@
 Two scenarios, as in 000 Sec VI-B: a collapsed two-storey fire station and a collapsed five-
 storey industrial building, each next to a smaller intact two-storey annex; and a ``small`` one,
 a single collapsed two-storey building on a smaller site, for quick checks and tests. 000 gives
-no storey counts; its Table 3 lists 4 and 10 levels for the two scenarios (each level a vertical
-step of the camera's view), so the industrial building is five storeys (17.5 m) tall, on a site
-with airspace above it, where three storeys (10.5 m) would hold only six levels. Each building is
-one ``building`` object whose faces carry the parts ``wall``, ``roof``, ``window``, ``rubble``
-and ``person``. One end of the main building has come down: its upper storeys are gone, a floor
-slab leans into the gap and rubble and casualties lie within 2 m of the walls, which leaves a
-ring at 3 m from the building free for a ground robot. Storeys are 3.5 m high, so each building
-offers at least two inspection levels.
+no storey counts; its Table 3 lists 4 and 10 Level nodes for the two buildings (each level a
+vertical step of the camera's view), so the industrial building is five storeys (17.5 m) tall,
+on a site with airspace above it, where three storeys (10.5 m) hold only six levels.
+Each building is one ``building`` object whose faces carry the parts ``wall``, ``roof``,
+``window``, ``rubble`` and ``person``. One end of the main building has come down: its upper
+storeys are gone, a floor slab leans into the gap and rubble and casualties lie within 2 m of
+the walls, which leaves a ring at 3 m from the building free for a ground robot. Storeys are
+3.5 m high, so each building offers at least two inspection levels.
 """
 
 from __future__ import annotations
