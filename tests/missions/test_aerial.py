@@ -7,6 +7,7 @@ people in its Feature layer for operator queries.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -70,3 +71,13 @@ def test_the_buildings_surface_coverage_is_reported_on_its_own(aerial_mission) -
     assert 0 < t6.surface_coverage_pct <= 100
     summary = (aerial_mission.run_dir / "summary.md").read_text()
     assert f"| {t6.surface_coverage_pct:.1f} |" in summary.split("## Targets")[1]
+
+
+def test_the_robot_flies_back_down_to_level_0_after_the_building(aerial_mission) -> None:
+    (building,) = aerial_mission.mission.graph.targets()
+    entry_height = building.levels[0].position[2]
+    assert building.levels[-1].position[2] > entry_height + 1.0  # it climbed
+    events = [e for e in aerial_mission.run_dir.joinpath("events.jsonl").read_text().splitlines()]
+    descents = [json.loads(e) for e in events if '"descended"' in e]
+    assert [d["reached"] for d in descents] == [True]
+    assert abs(descents[0]["height"] - entry_height) < 0.5

@@ -24,6 +24,19 @@ def test_collapsed_buildings_have_features_levels_and_a_free_ring(scenario) -> N
     assert world.is_free(points, 0.4, "ground").all()
 
 
+@pytest.mark.parametrize(("scenario", "storeys"), [("fire-station", 2), ("industrial", 5)])
+def test_main_building_is_as_tall_as_its_storeys_under_open_airspace(scenario, storeys) -> None:
+    """000 Table 3's 4 and 10 levels need a 7 m and a 17.5 m building (1.66 m level steps)."""
+    world = generate_world("collapsed-buildings", scenario)
+    main, annex = world.instances_of("building")
+    assert main.bbox_max[2] == pytest.approx(storeys * STOREY, abs=0.01)
+    assert annex.bbox_max[2] == pytest.approx(2 * STOREY, abs=0.01)
+    ceiling = world.bounds[1][2]
+    assert ceiling - main.bbox_max[2] >= 4.0  # a flying robot clears the roof by its margin
+    top = (*main.centroid[:2], main.bbox_max[2] + 2.0)
+    assert world.is_free([top], 0.4, "aerial")[0]
+
+
 def test_small_collapsed_site_holds_one_collapsed_building_with_every_feature() -> None:
     world = generate_world("collapsed-buildings", "small")
     (building,) = world.instances_of("building")

@@ -174,9 +174,10 @@ CITY_BUDGETS = {"small": 700.0, "medium": 1400.0, "large": 2800.0}
 DEFAULT_BUDGET_S = 3600.0
 
 #: Level cap among collapsed buildings. 000 gives no cap: levels climb until the structure's
-#: top is in view (eq 8 closes each one), 4 levels on the 7 m fire station and 6 on the 10.5 m
-#: industrial building at the 1.66 m vertical step. The cap is set above what the sites' 14 m
-#: of airspace hold (7 levels from 2 m), so the top, not the cap, ends the climb.
+#: top is in view (eq 8 closes each one), at the 1.66 m vertical step 4 levels on the 7 m fire
+#: station and 10 on the 17.5 m industrial building. The cap is set above what the sites'
+#: airspace holds (12 levels from 2 m under the industrial site's 22 m, the robot's clearance
+#: kept), so the top, not the cap, ends the climb.
 COLLAPSED_MAX_LEVELS = 16
 #: Per-world defaults: preset, mode, target classes, features, viewing distance, level cap,
 #: budget.

@@ -1,13 +1,16 @@
 """Collapsed multi-storey buildings with windows, people and rubble (000 Sec VI-B, Table 2).
 
-Two scenarios, as in 000 Sec VI-B: a collapsed two-storey fire station and a collapsed three-
-storey industrial building, each next to a smaller intact annex; and a ``small`` one, a single
-collapsed two-storey building on a smaller site, for quick checks and tests. Each building is
-one ``building`` object whose faces carry the parts ``wall``, ``roof``, ``window``, ``rubble``
-and ``person``. One end of the main building has come down: its upper storeys are gone, a floor
-slab leans into the gap and rubble and casualties lie within 2 m of the walls, which leaves a
-ring at 3 m from the building free for a ground robot. Storeys are 3.5 m high, so each building
-offers at least two inspection levels.
+Two scenarios, as in 000 Sec VI-B: a collapsed two-storey fire station and a collapsed five-
+storey industrial building, each next to a smaller intact two-storey annex; and a ``small`` one,
+a single collapsed two-storey building on a smaller site, for quick checks and tests. 000 gives
+no storey counts; its Table 3 lists 4 and 10 Level nodes for the two buildings (each level a
+vertical step of the camera's view), so the industrial building is five storeys (17.5 m) tall,
+on a site with airspace above it, where three storeys (10.5 m) hold only six levels.
+Each building is one ``building`` object whose faces carry the parts ``wall``, ``roof``,
+``window``, ``rubble`` and ``person``. One end of the main building has come down: its upper
+storeys are gone, a floor slab leans into the gap and rubble and casualties lie within 2 m of
+the walls, which leaves a ring at 3 m from the building free for a ground robot. Storeys are
+3.5 m high, so each building offers at least two inspection levels.
 """
 
 from __future__ import annotations
@@ -23,8 +26,9 @@ from seminspect.worlds.shapes import Piece, box, pose_matrix
 from seminspect.worlds.world import World
 
 SIZE = (80.0, 56.0, 14.0)
-#: Scenarios on a site of another size than ``SIZE``.
-SITE_SIZES = {"small": (36.0, 30.0, 10.0)}
+#: Scenarios on a site of another size than ``SIZE``; the industrial site's airspace reaches
+#: 4.5 m above its 17.5 m main building, room for the robot's clearance over its top level.
+SITE_SIZES = {"small": (36.0, 30.0, 10.0), "industrial": (80.0, 56.0, 22.0)}
 STOREY = 3.5
 START = (4.0, 4.0, 0.0)
 #: Rubble and people stay this close to the walls (metres).
@@ -48,7 +52,7 @@ SCENARIOS: dict[str, tuple[_Building, ...]] = {
         _Building((52.0, 20.0), 10.0, 8.0, 2, collapsed=False),
     ),
     "industrial": (
-        _Building((12.0, 14.0), 36.0, 20.0, 3, collapsed=True, rubble=70, people=3),
+        _Building((12.0, 14.0), 36.0, 20.0, 5, collapsed=True, rubble=70, people=3),
         _Building((62.0, 20.0), 12.0, 10.0, 2, collapsed=False),
     ),
     "small": (_Building((12.0, 11.0), 12.0, 8.0, 2, collapsed=True, rubble=12, people=1),),

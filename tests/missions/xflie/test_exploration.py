@@ -3,7 +3,7 @@ import math
 import numpy as np
 
 from fake_platform import FakePlatform, fake_context, headings_apart
-from seminspect.mapping.voxel import FREE, UNKNOWN
+from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN
 from seminspect.missions.config import survey_headings
 from seminspect.missions.xflie.exploration import FRONTIER_MIN_DISTANCE, Exploration
 
@@ -67,3 +67,22 @@ def test_exploration_chooses_only_among_the_frontiers_it_may_keep() -> None:
     assert exploration.explore(keep=lambda goal: goal[0] > 0.0)
     assert events.events[-1]["goal"][0] > 4.0  # the east frontier, though the west is nearer
     assert platform.position[0] > 3.0
+
+
+def test_an_aerial_robot_flies_to_a_frontier_level_round_a_wall(monkeypatch) -> None:
+    # A 3 m wall across the known half, open only at its north end: over it is shorter, but
+    # the robot keeps its height and goes round.
+    platform = FakePlatform(position=(-6.0, 0.0, 2.0))
+    ctx, events = fake_context(platform, settings={"mode": "aerial"}, height=8.0)
+    half_known(ctx)
+    wall = ctx.occupancy.world_to_index([[-3.0, -10.0, -0.25], [-2.5, 6.0, 3.0]])
+    ctx.occupancy.states[tuple(slice(a, b + 1) for a, b in wall.T)] = OCCUPIED
+    flown = []
+    move_to = platform.move_to
+    monkeypatch.setattr(
+        platform, "move_to", lambda point, yaw=None: flown.append(tuple(point)) or move_to(point)
+    )
+    assert Exploration(ctx).explore()
+    assert "frontier" in events.kinds()
+    heights = np.array(flown)[:, 2]
+    assert np.allclose(heights, 2.0) and max(abs(p[1]) for p in flown) > 6.0

@@ -5,6 +5,12 @@ the traversable node nearest the goal (when the graph gets the robot closer than
 straight); the rest is planned on the robot's own occupancy map into unknown space, to within
 ``ε`` of the target (eq 2's proximity condition). With ``planner="volumetric"`` (000 Sec VII-D's
 baseline) the volumetric planner plans the whole way instead.
+
+Aerial robots travel between targets at the height they fly (level with the robot, on a band of
+the map, so a route cannot climb over a roof to meet ``ε`` from above; a graph leg only to a
+node at that height, as their graph holds every level's poses), and leave an inspected
+target the way they climbed it (:meth:`Approach.descend`): every target's ``Level-0`` then
+starts at the first level's height, as the first target's does.
 """
 
 from __future__ import annotations
@@ -15,6 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from seminspect.core.errors import PlanningError
+from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.model import TargetNode, TargetStatus
 from seminspect.missions.config import ResolvedMissionConfig
 from seminspect.missions.navigation import RoutePlanner
@@ -48,6 +55,9 @@ ARRIVAL_FALLBACKS = (0.0, 1.0, 2.5)
 CONFIRM_OFFSETS = (0.0, math.radians(35), -math.radians(35))
 #: The graph leg is skipped unless it ends this much closer to the goal than the robot is [m].
 GRAPH_LEG_GAIN = 5.0
+#: Heights this close count as one flight level [m]: an aerial robot higher than its target's
+#: ``Level-0`` by more flies back down to it, and takes no graph leg to a node off its level.
+FLIGHT_LEVEL_TOLERANCE = 0.5
 
 
 class Approach:
@@ -74,10 +84,14 @@ class Approach:
         ctx = self.ctx
         goal = target.position
         ctx.event("selected", target=target.id, utility=round(target.utility, 4))
+        planner = self.baseline
+        if ctx.config.mode == "aerial" and planner is None:
+            goal = np.array([goal[0], goal[1], ctx.platform.position[2]])
+            planner = level_flight_planner(ctx.navigator.planner, goal[2])
         self.graph_leg(goal)
         for extra in ARRIVAL_FALLBACKS:
             radius = ctx.params.epsilon + extra
-            if ctx.navigator.go_to(goal, radius, planner=self.baseline):
+            if ctx.navigator.go_to(goal, radius, planner=planner):
                 ctx.event("arrived", target=target.id)
                 return True
             if ctx.time_left <= 0:
@@ -104,6 +118,38 @@ class Approach:
                 return True
         return False
 
+    def descend(self, target: TargetNode) -> None:
+        """Fly an inspected target's Level and Pose graphs back to its ``Level-0``.
+
+        The route runs through the view poses the robot flew and the climbs between levels
+        (each level's ``via``), all space the robot has been in, and is driven as planned, not
+        shortened: a shortcut would cross space below the robot that it has not seen.
+        """
+        ctx = self.ctx
+        entry = LayeredSemanticGraph.entry_level(target)
+        if ctx.platform.position[2] - entry.position[2] < FLIGHT_LEVEL_TOLERANCE:
+            return
+        with ctx.timers("planning"):
+            try:
+                plan = self.planner.plan(entry.id, ctx.platform.position)
+            except PlanningError:  # no route in the graph: travel on from where it is
+                return
+        ctx.recorder.plan(entry.id, plan)
+        ctx.navigator.planned(plan.timing.total_s)
+        descended = ctx.navigator.drive(plan.waypoints)
+        ctx.event(
+            "descended",
+            target=target.id,
+            reached=descended,
+            height=round(float(ctx.platform.position[2]), 2),
+        )
+
+    def on_flight_level(self, point: NDArray[np.float64]) -> bool:
+        """Whether ``point`` lies at the height an aerial robot flies (ground robots: always)."""
+        ctx = self.ctx
+        height = abs(point[2] - ctx.platform.position[2])
+        return ctx.config.mode != "aerial" or height <= FLIGHT_LEVEL_TOLERANCE
+
     def graph_leg(self, goal: NDArray[np.float64]) -> None:
         """The known part of the route: over the 3DLSG to the traversable node nearest ``goal``."""
         ctx = self.ctx
@@ -117,6 +163,8 @@ class Approach:
                 (goal - here)[:2]
             ):
                 return  # the graph gets the robot no closer than driving straight for it
+            if not self.on_flight_level(entry_position):
+                return  # an aerial robot's graph holds every level's poses: it travels level
             try:
                 plan = self.planner.plan(entry, here)
             except PlanningError:  # the Target layer does not join the two; drive without it
@@ -139,6 +187,18 @@ def local_planner(config: ResolvedMissionConfig) -> LocalPlanner:
     clearance = planning_clearance(config)
     model = CostModel(clearance, risk_radius=LOCAL_RISK_RADIUS, unknown_cost=1.0)
     return LocalPlanner(model, config.mode, band=config.robot.planning_band())
+
+
+def level_flight_planner(local: LocalPlanner, height: float) -> LocalPlanner:
+    """The aerial planner kept level at ``height``: routes on the band of the map within the
+    robot's clearance above and below it."""
+    clearance = local.model.robot_radius
+    return LocalPlanner(
+        local.model,
+        "ground",
+        band=(height - clearance, height + clearance),
+        heuristic_weight=local.heuristic_weight,
+    )
 
 
 def baseline_planner(config: ResolvedMissionConfig) -> RebuildingVolumetricPlanner | None:

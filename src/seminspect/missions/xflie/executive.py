@@ -9,8 +9,9 @@ The loop below is the whole mission; each phase lives in its own module:
    the unknown, to within ``ε``; the target is confirmed on arrival or discarded.
 3. :mod:`.inspection`: ``π^insp``, level by level (eqs 7-10), with :mod:`.surface` giving the
    view steps (002 eqs 1-2) and :mod:`.completion` ending each level (eq 8).
-4. :mod:`.links`: Target-layer edges to inspected neighbours; then ``π^expl:LE``, a survey
-   around the inspected target.
+4. :mod:`.links`: Target-layer edges to inspected neighbours; an aerial robot flies back down
+   to the target's ``Level-0`` the way it climbed; then ``π^expl:LE``, a survey around the
+   inspected target.
 5. Repeat until no uninspected target remains and no frontier is left, or the time budget ends.
 
 Every planner call's wall time is recorded by the :class:`MissionRecorder`; with
@@ -221,6 +222,8 @@ class XFlie:
         if self.run is not None:
             self.run.write_graph(self.graph, snapshot_time=self.platform.time)
             self.run.flush_events()
+        if self.config.mode == "aerial":
+            self.approach.descend(target)
 
     def _on_transit_frame(self, frame: Frame) -> None:
         """A frame the navigator took while driving: into the map, and its targets registered."""

@@ -4,7 +4,8 @@ A survey turns the robot through a full circle in steps of the camera's field of
 the configured overlap) and registers every frame's target detections (eqs 3-5). When no
 uninspected target is left, the robot drives to the nearest frontier between known free and
 unknown space and surveys there; frontiers it visited, or tried and could not reach, are
-remembered and not chosen again.
+remembered and not chosen again. Aerial robots fly there level, at their height, as between
+targets (``approach.level_flight_planner``).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from seminspect.missions.config import survey_headings
+from seminspect.missions.xflie.approach import level_flight_planner
 from seminspect.missions.xflie.context import MissionContext
 from seminspect.missions.xflie.sightings import register_targets
 from seminspect.planning.frontier import find_frontiers
@@ -81,9 +83,12 @@ class Exploration:
             and (keep is None or keep(f.goal))
         ]
         candidates.sort(key=lambda f: distance(f.goal))
+        planner = None
+        if ctx.config.mode == "aerial":  # goals lie at its height: no route over the roofs
+            planner = level_flight_planner(ctx.navigator.planner, here[2])
         for frontier in candidates[:FRONTIER_TRIES]:
             self.spent_frontiers.append(frontier.goal)
-            if ctx.navigator.go_to(frontier.goal, radius=FRONTIER_RADIUS):
+            if ctx.navigator.go_to(frontier.goal, radius=FRONTIER_RADIUS, planner=planner):
                 ctx.event("frontier", goal=frontier.goal.round(2).tolist(), cells=frontier.cells)
                 self.survey()
                 return True
