@@ -3,7 +3,12 @@ import numpy as np
 from fake_platform import FakePlatform, fake_context
 from seminspect.graphs.lsg.model import TargetStatus
 from seminspect.mapping.voxel import OCCUPIED
-from seminspect.missions.xflie.inspection import LevelInspection, dilate, platform_vfov
+from seminspect.missions.xflie.inspection import (
+    ROOF_CLEARANCE_M,
+    LevelInspection,
+    dilate,
+    platform_vfov,
+)
 from seminspect.perception.observation import Observation
 from seminspect.planning.view_planner import ViewConstraints
 
@@ -51,11 +56,25 @@ def test_an_aerial_robot_climbs_only_while_the_target_rises_above_its_view() -> 
     )
     with ctx.timers("graph"):
         ctx.graph.begin_inspection(car.id, ctx.view_pose(image=None))
-    assert not inspection.climb(car, heights=[2.5])  # the view already reaches the top
+    assert not inspection.climb(car, heights=[1.4])  # the robot already sees it from above
     assert platform.position[2] == 2.0
     assert inspection.climb(car, heights=[12.0])
     assert platform.position[2] == 2.0 + inspection.view.vertical_step
     assert events.kinds()[-1] == "level" and len(car.levels) == 2
+
+
+def test_an_aerial_robot_climbs_once_more_to_see_a_roof_its_view_already_reaches() -> None:
+    platform = FakePlatform(position=(1.0, 0.0, 2.0))
+    ctx, events, inspection, car = inspection_of_a_car(
+        platform, settings={"mode": "aerial"}, height=8.0
+    )
+    with ctx.timers("graph"):
+        ctx.graph.begin_inspection(car.id, ctx.view_pose(image=None))
+    roof = 2.0 + ROOF_CLEARANCE_M / 2  # within the view, but not below the robot by the margin
+    assert inspection.climb(car, heights=[roof])
+    assert platform.position[2] == 2.0 + inspection.view.vertical_step
+    assert events.kinds()[-1] == "level" and len(car.levels) == 2
+    assert not inspection.climb(car, heights=[roof])  # now above it
 
 
 def test_an_aerial_robot_does_not_climb_into_structure_it_has_mapped_above_it() -> None:

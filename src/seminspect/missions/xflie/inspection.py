@@ -4,7 +4,8 @@
 its image (eq 9) and the part detections on the target go to the interim Pose-Feature graph;
 the surface tracker gives the next view (002 eqs 1-2) until :class:`LevelCompletion` ends the
 level (eq 8). Each level is then pruned (eq 10). Aerial robots climb one vertical step while the
-target rises above the view; ground robots do one level.
+target rises above the view or above the robot itself (a roof is seen only from above it);
+ground robots do one level.
 """
 
 from __future__ import annotations
@@ -32,6 +33,9 @@ PART_OVERLAP = 0.5
 MASK_GROWTH_PX = 5
 #: An inspection with fewer views than this in its first level is cancelled.
 MIN_VIEWS = 3
+#: Aerial robots fly their last level at least this far above the target's observed top, so
+#: that its roof is in view as well as its walls [m].
+ROOF_CLEARANCE_M = 0.5
 
 
 class LevelInspection:
@@ -141,12 +145,14 @@ class LevelInspection:
                     ctx.graph.register_feature(z)
 
     def climb(self, target: TargetNode, heights: list[float]) -> bool:
-        """Start the next level one vertical step up, while the target rises above the view."""
+        """Start the next level one vertical step up, while the target rises above the view
+        or the robot has not yet risen ``ROOF_CLEARANCE_M`` above the target's top."""
         ctx = self.ctx
         top = max(heights) if heights else target.position[2]
         half = math.radians(self.view.vfov_deg) / 2
         reach = self.view.d_view * math.tan(half - self.camera_pitch)
-        if ctx.platform.position[2] + reach >= top:
+        altitude = ctx.platform.position[2]
+        if altitude + reach >= top and altitude >= top + ROOF_CLEARANCE_M:
             return False
         here = ctx.platform.position
         goal = here + np.array([0.0, 0.0, self.view.vertical_step])
