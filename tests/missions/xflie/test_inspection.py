@@ -28,6 +28,16 @@ def inspection_of_a_car(platform=None, settings=None, height=3.0):
     return ctx, events, inspection, ctx.graph.target("car-0")
 
 
+def aerial_inspection_begun(platform):
+    """An aerial robot's inspection of the car, begun where the robot is."""
+    ctx, events, inspection, car = inspection_of_a_car(
+        platform, settings={"mode": "aerial"}, height=8.0
+    )
+    with ctx.timers("graph"):
+        ctx.graph.begin_inspection(car.id, ctx.view_pose(image=None))
+    return ctx, events, inspection, car
+
+
 def test_a_ground_robot_circles_the_target_once_and_leaves_it_inspected() -> None:
     ctx, events, inspection, car = inspection_of_a_car(FakePlatform(position=(1.0, 0.0, 0.7)))
     assert inspection.inspect(car)
@@ -51,11 +61,7 @@ def test_an_inspection_with_too_few_views_is_cancelled() -> None:
 
 def test_an_aerial_robot_climbs_only_while_the_target_rises_above_its_view() -> None:
     platform = FakePlatform(position=(1.0, 0.0, 2.0))
-    ctx, events, inspection, car = inspection_of_a_car(
-        platform, settings={"mode": "aerial"}, height=8.0
-    )
-    with ctx.timers("graph"):
-        ctx.graph.begin_inspection(car.id, ctx.view_pose(image=None))
+    _ctx, events, inspection, car = aerial_inspection_begun(platform)
     assert not inspection.climb(car, heights=[1.4])  # the robot already sees it from above
     assert platform.position[2] == 2.0
     assert inspection.climb(car, heights=[12.0])
@@ -65,11 +71,7 @@ def test_an_aerial_robot_climbs_only_while_the_target_rises_above_its_view() -> 
 
 def test_an_aerial_robot_climbs_once_more_to_see_a_roof_its_view_already_reaches() -> None:
     platform = FakePlatform(position=(1.0, 0.0, 2.0))
-    ctx, events, inspection, car = inspection_of_a_car(
-        platform, settings={"mode": "aerial"}, height=8.0
-    )
-    with ctx.timers("graph"):
-        ctx.graph.begin_inspection(car.id, ctx.view_pose(image=None))
+    _ctx, events, inspection, car = aerial_inspection_begun(platform)
     roof = 2.0 + ROOF_CLEARANCE_M / 2  # within the view, but not below the robot by the margin
     assert inspection.climb(car, heights=[roof])
     assert platform.position[2] == 2.0 + inspection.view.vertical_step
@@ -79,12 +81,8 @@ def test_an_aerial_robot_climbs_once_more_to_see_a_roof_its_view_already_reaches
 
 def test_an_aerial_robot_does_not_climb_into_structure_it_has_mapped_above_it() -> None:
     platform = FakePlatform(position=(1.0, 0.0, 2.0))
-    ctx, events, inspection, car = inspection_of_a_car(
-        platform, settings={"mode": "aerial"}, height=8.0
-    )
+    ctx, events, inspection, car = aerial_inspection_begun(platform)
     ctx.occupancy.states[:, :, ctx.occupancy.world_to_index([0, 0, 3.5])[2]] = OCCUPIED  # a slab
-    with ctx.timers("graph"):
-        ctx.graph.begin_inspection(car.id, ctx.view_pose(image=None))
     assert not inspection.climb(car, heights=[12.0])
     assert platform.position[2] == 2.0 and platform.distance_travelled == 0.0
     assert events.kinds()[-1] == "climb-blocked" and len(car.levels) == 1
