@@ -25,14 +25,14 @@ $(VENV)/.installed-test: pyproject.toml $(LOCK) | $(BIN)/python
 	touch $@ $(VENV)/.installed-run
 
 # numba compiles each kernel on its first call and caches it beside the source. One short
-# mission right after install compiles what missions use, so that the first mission a user
-# runs starts warm: the compilation (tens of seconds) moves from that mission to the install.
+# mission right after install, on the default world and with its pictures, compiles what
+# missions use and stores the world's collision grid in seminspect's cache, so that the first
+# mission a user runs starts warm: the compilation (tens of seconds) moves to the install.
 WARM_UP_RUN := $(VENV)/warm-up-run
 $(VENV)/.compiled: $(VENV)/.installed-run
 	@echo 'Compiling the kernels with one short mission (a minute or two, once per install)...'
 	rm -rf $(WARM_UP_RUN)
-	$(BIN)/seminspect mission --world city --scenario small --budget 300 --no-pictures \
-		--out $(WARM_UP_RUN) > /dev/null
+	$(BIN)/seminspect mission --budget 300 --out $(WARM_UP_RUN) > /dev/null
 	rm -rf $(WARM_UP_RUN)
 	touch $@
 
