@@ -88,6 +88,7 @@ def cached_array(kind: str, key: str, build: Callable[[], NDArray]) -> NDArray:
     folder = cache_dir()
     if folder is None:
         return build()
+    limit_bytes = cache_limit_bytes()  # a bad bound is an error before any work, hit or miss
     path = folder / kind / f"{key}.npy"
     try:
         array = np.load(path, allow_pickle=False)
@@ -99,7 +100,7 @@ def cached_array(kind: str, key: str, build: Callable[[], NDArray]) -> NDArray:
     try:
         with atomic_output(path) as temporary:
             np.save(temporary, array, allow_pickle=False)
-        evict_least_recent(folder, cache_limit_bytes())
+        evict_least_recent(folder, limit_bytes)
     except OSError:  # a read-only or full disk: the array is still good
         pass
     return array
