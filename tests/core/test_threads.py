@@ -1,4 +1,5 @@
 import os
+import threading
 
 import numpy as np
 import pytest
@@ -7,9 +8,10 @@ from scipy.spatial.transform import Rotation
 from seminspect.core.threads import (
     MAX_SENSOR_THREADS,
     THREADS_ENV,
+    deal_range,
     rotate_rows,
+    run_dealt,
     sensor_threads,
-    split_range,
 )
 
 
@@ -51,10 +53,32 @@ def test_sensor_threads_keep_to_the_cores_and_the_settings(monkeypatch):
     assert sensor_threads() == 1
 
 
-def test_split_range_covers_the_range_in_order_or_keeps_it_whole():
-    parts = split_range(10_000, 3, 1000)
-    assert [p.start for p in parts] == [0, *(p.stop for p in parts[:-1])]
-    assert parts[-1].stop == 10_000 and len(parts) == 3
-    assert max(p.stop - p.start for p in parts) - min(p.stop - p.start for p in parts) <= 1
-    assert split_range(1999, 2, 1000) == [slice(0, 1999)]  # under two threads' worth
-    assert split_range(10_000, 1, 1000) == [slice(0, 10_000)]
+def test_deal_range_covers_the_range_once_in_blocks_dealt_in_turn():
+    hands = deal_range(10_000, 3, 1000, blocks_per_thread=4)
+    assert len(hands) == 3 and all(len(hand) == 4 for hand in hands)
+    blocks = sorted((block for hand in hands for block in hand), key=lambda b: b.start)
+    assert [b.start for b in blocks] == [0, *(b.stop for b in blocks[:-1])]
+    assert blocks[-1].stop == 10_000
+    assert max(b.stop - b.start for b in blocks) - min(b.stop - b.start for b in blocks) <= 1
+    # Dealt in turn: a thread's blocks are every third one, so each gets a share of every region.
+    assert [b.start for b in hands[1]] == [b.start for b in blocks[1::3]]
+
+
+def test_deal_range_keeps_small_or_single_threaded_work_whole():
+    assert deal_range(1999, 2, 1000) == [[slice(0, 1999)]]  # under two threads' worth
+    assert deal_range(10_000, 1, 1000) == [[slice(0, 10_000)]]
+
+
+@pytest.mark.parametrize("threads", [1, 2, 3])
+def test_run_dealt_does_every_item_once_the_caller_its_own_hand(threads):
+    done = np.zeros(50_000, dtype=np.int64)
+    workers: dict[int, int] = {}
+
+    def work(block: slice) -> None:
+        workers[block.start] = threading.get_ident()
+        done[block] += 1
+
+    run_dealt(work, len(done), threads, 1000)
+    assert np.all(done == 1)
+    mine = {start for start, worker in workers.items() if worker == threading.get_ident()}
+    assert mine == {block.start for block in deal_range(len(done), threads, 1000)[0]}

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import itertools
 import os
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from functools import cache
 
@@ -69,10 +70,42 @@ def thread_pool(threads: int) -> ThreadPoolExecutor:
     return ThreadPoolExecutor(threads, thread_name_prefix="seminspect")
 
 
-def split_range(count: int, threads: int, min_per_thread: int) -> list[slice]:
-    """``range(count)`` in contiguous parts, one per thread; one part when a thread would get
-    fewer than ``min_per_thread`` items (below that, splitting costs more than it saves)."""
+#: Blocks per thread when a batch is dealt out: enough that each thread gets a share of every
+#: part of an image or a scan, few enough that a block's call overhead stays negligible.
+BLOCKS_PER_THREAD = 8
+
+
+def deal_range(
+    count: int, threads: int, min_per_thread: int, blocks_per_thread: int = BLOCKS_PER_THREAD
+) -> list[list[slice]]:
+    """``range(count)`` cut into contiguous blocks dealt out in turn, one hand per thread; one
+    hand of one block when a thread would get fewer than ``min_per_thread`` items (below that,
+    splitting costs more than it saves).
+
+    Dealing rather than halving balances the threads: a camera's top rows see sky and far walls
+    and cast much faster than its bottom rows, and a LiDAR's rings differ the same way, so
+    contiguous halves left one thread waiting for the other (docs/benchmarks.md).
+    """
     if threads <= 1 or count < 2 * min_per_thread:
-        return [slice(0, count)]
-    bounds = np.linspace(0, count, threads + 1).astype(int)
-    return [slice(int(a), int(b)) for a, b in itertools.pairwise(bounds)]
+        return [[slice(0, count)]]
+    bounds = np.linspace(0, count, threads * blocks_per_thread + 1).astype(int)
+    blocks = [slice(int(a), int(b)) for a, b in itertools.pairwise(bounds)]
+    return [blocks[thread::threads] for thread in range(threads)]
+
+
+def run_dealt(
+    work: Callable[[slice], object], count: int, threads: int, min_per_thread: int
+) -> None:
+    """Call ``work`` on every block of :func:`deal_range`: the calling thread works through the
+    first hand while the pool works through the others. For work whose result does not depend
+    on the split (each item on its own) and that releases the GIL."""
+    hands = deal_range(count, threads, min_per_thread)
+
+    def work_through(hand: list[slice]) -> None:
+        for block in hand:
+            work(block)
+
+    others = [thread_pool(threads).submit(work_through, hand) for hand in hands[1:]]
+    work_through(hands[0])
+    for other in others:
+        other.result()

@@ -24,7 +24,7 @@ from scipy.spatial.transform import Rotation
 
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.params import InspectionParams
-from seminspect.core.threads import rotate_rows, split_range, thread_pool
+from seminspect.core.threads import rotate_rows, run_dealt
 from seminspect.geometry.transforms import Quat, Vec3, as_point, as_quaternion
 from seminspect.sensors.noise import NoiseModel, NormalStream, require_rng
 from seminspect.sensors.shading import OCTAVE_WEIGHTS, OCTAVES, shade_hits, surface_tables
@@ -240,12 +240,8 @@ def render(
             intensity[part],
         )
 
-    # Pixels shade independently: the calling thread shades the first part, the pool the rest.
-    parts = split_range(count, threads, MIN_PIXELS_PER_THREAD)
-    others = [thread_pool(threads).submit(shade, part) for part in parts[1:]]
-    shade(parts[0])
-    for other in others:
-        other.result()
+    # Pixels shade independently, so they may be dealt out over threads.
+    run_dealt(shade, count, threads, MIN_PIXELS_PER_THREAD)
     shape = (model.height, model.width)
     frame = Frame(
         depth=depth.reshape(shape),

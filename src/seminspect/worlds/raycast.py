@@ -10,6 +10,7 @@ loop is the fallback where its library cannot be loaded, with the same hits.
 
 from __future__ import annotations
 
+from functools import partial
 from typing import NamedTuple
 
 import numpy as np
@@ -18,7 +19,7 @@ from embreex.mesh_construction import TriangleMesh
 from numpy.typing import ArrayLike, NDArray
 
 from seminspect.core.errors import InvalidInputError
-from seminspect.core.threads import split_range, thread_pool
+from seminspect.core.threads import run_dealt
 from seminspect.worlds.embree import MAX_TFAR, EmbreeScene, cast_rays, embree_library
 
 #: Embree's "no hit" primitive id.
@@ -91,13 +92,8 @@ class RayCaster:
             raise InvalidInputError(f"max_range must be one value or {count}, got {limit.shape}")
         distance, face = _outputs(count, out)
         batch = _Batch(starts, dirs, limit, distance, face)
-        parts = split_range(count, threads, MIN_RAYS_PER_THREAD)
         cast_part = self._cast_compiled if self._compiled is not None else self._cast_embreex
-        # The calling thread casts the first part while the pool casts the others.
-        others = [thread_pool(threads).submit(cast_part, batch, part) for part in parts[1:]]
-        cast_part(batch, parts[0])
-        for other in others:
-            other.result()
+        run_dealt(partial(cast_part, batch), count, threads, MIN_RAYS_PER_THREAD)
         return batch.distance, batch.face
 
     def _cast_compiled(self, batch: _Batch, part: slice) -> None:
