@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -30,7 +31,7 @@ from seminspect.geometry.transforms import as_point, as_points
 from seminspect.mapping import carving
 from seminspect.mapping.semantic_cloud import read_npz
 from seminspect.mapping.traversal import integrate_rays_kernel
-from seminspect.sensors import Frame, LidarScan
+from seminspect.sensors import CameraModel, Frame, LidarScan
 from seminspect.worlds import World
 
 UNKNOWN: int = 0
@@ -222,27 +223,23 @@ class VoxelMap:
         """
         if not (isinstance(stride, int) and stride >= 1):
             raise InvalidInputError(f"stride must be a positive integer, got {stride!r}")
-        height, width = frame.shape
-        rows, cols = np.meshgrid(np.arange(0, height, stride), np.arange(0, width, stride))
-        flat = (rows * width + cols).ravel()
-        directions, cosine = frame.camera.rays
+        rows, cols, flat, directions, cosine = _strided_pixels(frame.camera, stride)
         depth = frame.depth.ravel()[flat]
         hit = np.isfinite(depth)
-        length = np.where(hit, depth, frame.camera.max_range) / cosine[flat]
+        length = np.where(hit, depth, frame.camera.max_range) / cosine
         position, orientation = (
             (frame.odometry_position, frame.odometry_orientation)
             if use_odometry
             else (frame.position, frame.orientation)
         )
         rotation = Rotation.from_quat(orientation).as_matrix()
-        ends = position + rotate_rows(directions[flat] * length[:, None], rotation)
+        ends = position + rotate_rows(directions * length[:, None], rotation)
         starts = None
         if carving_spacing is not None:
             # Neighbouring pixels of the strided grid are stride / fx radians apart at the centre,
             # the widest step of a pinhole camera.
             levels = np.minimum(
-                carving.index_levels(rows.ravel() // stride),
-                carving.index_levels(cols.ravel() // stride),
+                carving.index_levels(rows // stride), carving.index_levels(cols // stride)
             )
             step = stride / frame.camera.fx
             starts = carving.carve_from(levels, length, step, self.resolution, carving_spacing)
@@ -329,6 +326,22 @@ class VoxelMap:
             states = _coarsen_axis(states, axis, self.resolution / resolution, coarse.shape[axis])
         coarse.states[:] = states
         return coarse
+
+
+@lru_cache(maxsize=8)
+def _strided_pixels(camera: CameraModel, stride: int) -> tuple[NDArray, ...]:
+    """Every ``stride``-th pixel of ``camera``'s image (rows and columns): their rows, columns,
+    flat indices, body-frame ray directions and those rays' x parts, computed once per camera
+    (read-only: they are shared by every frame)."""
+    rows, cols = np.meshgrid(
+        np.arange(0, camera.height, stride), np.arange(0, camera.width, stride)
+    )
+    flat = (rows * camera.width + cols).ravel()
+    directions, cosine = camera.rays
+    pixels = (rows.ravel(), cols.ravel(), flat, directions[flat], cosine[flat])
+    for array in pixels:
+        array.flags.writeable = False
+    return pixels
 
 
 def _coarsen_axis(states: NDArray[np.uint8], axis: int, ratio: float, size: int) -> NDArray:
