@@ -35,6 +35,19 @@ def test_rotate_rows_into_a_reused_buffer_gives_the_same_numbers():
         assert np.array_equal(buffer, rows @ rotation.T)
 
 
+@pytest.mark.parametrize("threads", [2, 3])
+def test_rotate_rows_dealt_to_threads_gives_the_same_numbers(threads):
+    rng = np.random.default_rng(5)
+    rows = rng.normal(size=(307_201, 3)).astype(np.float32)  # a frame's rays, and one more
+    buffer = np.full_like(rows, np.nan)
+    for quaternion in rng.normal(size=(3, 4)):
+        rotation = Rotation.from_quat(quaternion).as_matrix().astype(np.float32)
+        expected = rotate_rows(rows, rotation)
+        assert np.array_equal(rotate_rows(rows, rotation, threads=threads), expected)
+        assert rotate_rows(rows, rotation, out=buffer, threads=threads) is buffer
+        assert np.array_equal(buffer, expected)
+
+
 def test_rotate_rows_rotates():
     quarter_turn = Rotation.from_euler("z", 90, degrees=True).as_matrix()
     assert np.allclose(rotate_rows(np.array([[1.0, 0.0, 0.0]]), quarter_turn), [[0, 1, 0]])

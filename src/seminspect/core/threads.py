@@ -26,14 +26,31 @@ def _controller() -> ThreadpoolController:
     return ThreadpoolController()
 
 
-def rotate_rows(vectors: NDArray, rotation: NDArray, out: NDArray | None = None) -> NDArray:
+def rotate_rows(
+    vectors: NDArray, rotation: NDArray, out: NDArray | None = None, threads: int = 1
+) -> NDArray:
     """``vectors @ rotation.T`` (``(N, 3)`` rows by a ``(3, 3)`` matrix) on one BLAS thread.
 
     ``out``, when given, is an ``(N, 3)`` array of the product's dtype that receives the rows
-    (a buffer reused between calls saves the allocation; the numbers are the same).
+    (a buffer reused between calls saves the allocation; the numbers are the same). With
+    ``threads`` > 1 blocks of rows are dealt out to that many threads (:func:`run_dealt`),
+    each row computed by the same kernel, so again the same numbers.
     """
+    rows, turn = np.asarray(vectors), np.asarray(rotation).T
     with _controller().limit(limits=1, user_api="blas"):
-        return np.matmul(np.asarray(vectors), np.asarray(rotation).T, out=out)
+        if threads <= 1:
+            return np.matmul(rows, turn, out=out)
+        product = np.empty(rows.shape, np.result_type(rows, turn)) if out is None else out
+
+        def rotate(block: slice) -> None:
+            np.matmul(rows[block], turn, out=product[block])
+
+        run_dealt(rotate, len(rows), threads, MIN_ROWS_PER_THREAD)
+        return product
+
+
+#: Below this many rows per thread, dealing a rotation out costs more than it saves.
+MIN_ROWS_PER_THREAD = 16_384
 
 
 #: Environment variable that sets :func:`sensor_threads`.

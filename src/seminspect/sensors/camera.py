@@ -201,7 +201,7 @@ def render(
     count = len(cosine)
     directions, distance = _scratch(count)
     rotation = Rotation.from_quat(quat).as_matrix().astype(np.float32)
-    rotate_rows(directions_body, rotation, out=directions)
+    rotate_rows(directions_body, rotation, out=directions, threads=threads)
     distance, face = world.raycaster.cast(
         origin,
         directions,
