@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from seminspect.core.errors import InvalidInputError
 from seminspect.core.threads import (
     MAX_SENSOR_THREADS,
     THREADS_ENV,
@@ -62,8 +63,16 @@ def test_sensor_threads_keep_to_the_cores_and_the_settings(monkeypatch):
     assert sensor_threads() == 1
     monkeypatch.setenv(THREADS_ENV, "3")
     assert sensor_threads() == 3
-    monkeypatch.setenv(THREADS_ENV, "none")  # not a count: ignored
-    assert sensor_threads() == 1
+    monkeypatch.setenv("OMP_NUM_THREADS", "many")  # another library's setting: passed over
+    monkeypatch.delenv(THREADS_ENV)
+    assert sensor_threads() == min(MAX_SENSOR_THREADS, cores)
+
+
+@pytest.mark.parametrize("setting", ["none", "0", "-2", "1.5"])
+def test_an_unusable_thread_count_is_refused_in_one_line(monkeypatch, setting):
+    monkeypatch.setenv(THREADS_ENV, setting)
+    with pytest.raises(InvalidInputError, match=f"{THREADS_ENV} must be a whole number"):
+        sensor_threads()
 
 
 def test_deal_range_covers_the_range_once_in_blocks_dealt_in_turn():

@@ -19,6 +19,8 @@ import numpy as np
 from numpy.typing import NDArray
 from threadpoolctl import ThreadpoolController
 
+from seminspect.core.errors import InvalidInputError
+
 
 @cache
 def _controller() -> ThreadpoolController:
@@ -66,16 +68,24 @@ def sensor_threads() -> int:
     :data:`MAX_SENSOR_THREADS` and at most ``$OMP_NUM_THREADS`` (which Ray sets to a task's
     CPUs, so the missions of a sweep keep to one thread each). Results never depend on it:
     every ray is cast on its own, whichever thread casts it.
+
+    Raises:
+        InvalidInputError: ``$SEMINSPECT_THREADS`` is set but not a whole number >= 1 (an
+            unusable ``$OMP_NUM_THREADS`` belongs to other libraries and is passed over).
     """
-    chosen = _positive(THREADS_ENV)
-    if chosen is not None:
-        return chosen
+    chosen = os.environ.get(THREADS_ENV, "").strip()
+    if chosen:
+        if _positive(chosen) is None:
+            raise InvalidInputError(
+                f"{THREADS_ENV} must be a whole number of threads >= 1, got {chosen!r}"
+            )
+        return int(chosen)
     cores = min(MAX_SENSOR_THREADS, len(os.sched_getaffinity(0)))
-    return min(cores, _positive("OMP_NUM_THREADS") or cores)
+    return min(cores, _positive(os.environ.get("OMP_NUM_THREADS", "")) or cores)
 
 
-def _positive(variable: str) -> int | None:
-    value = os.environ.get(variable, "").strip()
+def _positive(value: str) -> int | None:
+    value = value.strip()
     return int(value) if value.isdigit() and int(value) >= 1 else None
 
 
