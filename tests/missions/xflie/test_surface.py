@@ -1,4 +1,5 @@
 import numpy as np
+from scipy.spatial import cKDTree
 
 from fake_platform import FakePlatform, fake_context
 from seminspect.mapping.voxel import OCCUPIED
@@ -39,6 +40,25 @@ def test_a_point_set_keeps_one_point_per_voxel_and_answers_radius_queries() -> N
     assert points.size == 2
     near = points.near(np.array([[0.0, 0.0, 0.3], [3.0, 0.0, 0.0]]), 0.5)
     assert near.tolist() == [True, False]
+
+
+def test_radius_queries_answer_as_the_whole_tree_does_near_and_far() -> None:
+    """Queries outside the set's box, on its edge and across it give the tree's own answers."""
+    rng = np.random.default_rng(1)
+    cloud = PointSet(0.1)
+    cloud.add(rng.uniform([0, 0, 0], [2, 1, 1], (500, 3)))
+    queries = np.vstack(
+        [
+            rng.uniform(-3, 5, (4000, 3)),
+            cloud.points[:50] + np.array([0.5, 0.0, 0.0]),  # the radius away along x
+            cloud.points[:50] + np.array([0.5 + 1e-12, 0.0, 0.0]),
+        ]
+    )
+    for radius in (0.05, 0.5, 2.0):
+        distance, _ = cKDTree(cloud.points).query(queries, distance_upper_bound=radius)
+        expected = np.isfinite(distance)
+        assert 0 < expected.sum() < len(queries)
+        np.testing.assert_array_equal(cloud.near(queries, radius), expected)
 
 
 def test_adding_views_keeps_the_first_point_of_each_voxel_in_order() -> None:

@@ -64,11 +64,21 @@ class PointSet:
             self._tree = None
 
     def near(self, points: NDArray[np.float64], radius: float) -> NDArray[np.bool_]:
-        """Which ``points`` lie within ``radius`` of the set."""
+        """Which ``points`` lie within ``radius`` of the set.
+
+        Only points inside the set's bounding box grown by ``radius`` (and a hair, against
+        rounding) can be, so only those are looked up in the tree: a scan's returns are mostly
+        far from the target.
+        """
         if self._tree is None:
             self._tree = cKDTree(self.points)
-        distance, _ = self._tree.query(points, distance_upper_bound=radius)
-        return np.isfinite(distance)
+        reach = radius * (1 + 1e-9) + 1e-9
+        lower, upper = self._tree.mins - reach, self._tree.maxes + reach
+        candidates = np.flatnonzero(np.all((points >= lower) & (points <= upper), axis=1))
+        found = np.zeros(len(points), dtype=bool)
+        distance, _ = self._tree.query(points[candidates], distance_upper_bound=radius)
+        found[candidates] = np.isfinite(distance)
+        return found
 
 
 def first_of_each_row(cells: NDArray[np.int64]) -> NDArray[np.intp]:
