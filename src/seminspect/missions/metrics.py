@@ -103,7 +103,8 @@ class CoverageRecorder:
     def add_frame(self, target_id: str, frame: Frame, mask_points: NDArray[np.float64]) -> None:
         record = self.targets[target_id]
         close = (frame.face >= 0) & (frame.depth <= self.max_range)
-        record.faces.update(np.unique(frame.face[close]).tolist())
+        # Counting beats sorting a frame's faces: the ids are small and dense.
+        record.faces.update(np.flatnonzero(np.bincount(frame.face[close])).tolist())
         record.add_points(mask_points)
 
     def surface_coverage(self, target_id: str, world: World, instance_id: int) -> float:
