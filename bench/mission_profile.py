@@ -7,7 +7,9 @@ and splits its wall time into stages:
 * rendering: what ``render`` does around the rays (shading, labels, intensity texture);
 * noise: the image noise of a frame (where the mission draws it ahead on a worker thread,
   ``sensors.noise.NormalStream``, the compiled pass and any wait for the draw);
-* map integration: ``integrate_rays_kernel`` (free-space carving and occupied end cells);
+* map integration: what the mission's thread spends on it: ``VoxelMap.integrate_rays``
+  (preparing the rays and, on one thread, walking them) and ``VoxelMap.settle`` (waiting for
+  the walks handed to the map's worker thread, with a second core);
 * the mission's own categories for the rest (perception, planning, graph, driving, and
   sensing left after the stages above), and I/O and setup as what no timer covers.
 
@@ -48,7 +50,8 @@ STAGES = (
     (camera, "shade_hits", "rendering"),
     (platform, "render", "rendering"),
     (camera, "_add_image_noise", "noise"),
-    (voxel, "integrate_rays_kernel", "map integration"),
+    (voxel.VoxelMap, "integrate_rays", "map integration"),
+    (voxel.VoxelMap, "settle", "map integration"),
 )
 
 

@@ -1,4 +1,5 @@
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -9,7 +10,7 @@ from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.core.io import save_npz_atomic
 from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap, load_map, save_map
-from seminspect.sensors import CameraModel, Lidar, render
+from seminspect.sensors import CameraModel, Lidar, LidarScan, render
 from sim_worlds import box_world
 
 
@@ -281,3 +282,52 @@ def test_a_map_over_a_strided_view_is_kept_c_ordered_and_integrates_rays() -> No
     assert grid.states.flags.c_contiguous and grid.shape == (4, 6, 4)
     grid.integrate_rays([0.1, 0.1, 0.1], [[1.9, 0.1, 0.1]], [True])
     assert grid.states[3, 0, 0] == OCCUPIED and grid.states[:3, 0, 0].tolist() == [FREE] * 3
+
+
+def _frames_and_scans(world):
+    """Frames and scans from a few poses, in the order a robot would take them."""
+    lidar = Lidar(horizontal_resolution_deg=1.0)
+    for x, yaw in ((0.0, -0.3), (1.0, 0.0), (2.0, 0.3)):
+        pose = ((x, 0.0, 1.0), quat_from_yaw(yaw))
+        yield render(world, CameraModel(160, 120), *pose)
+        yield lidar.scan(world, *pose)
+
+
+def _integrate(voxel_map, reading) -> None:
+    if isinstance(reading, LidarScan):
+        voxel_map.integrate_scan(reading, clear_misses_to=10.0)
+    else:
+        voxel_map.integrate_frame(reading, stride=2)
+
+
+def test_background_integration_gives_the_same_map_in_the_same_order(wall_world) -> None:
+    in_place, background = VoxelMap.covering(wall_world, 0.2), VoxelMap.covering(wall_world, 0.2)
+    background.background = True
+    for reading in _frames_and_scans(wall_world):
+        _integrate(in_place, reading)
+        _integrate(background, reading)
+        # Every read waits for the walks handed over before it.
+        np.testing.assert_array_equal(background.states, in_place.states)
+    assert in_place.counts()["occupied"] > 300
+
+
+def test_a_map_with_walks_pending_waits_before_it_is_written_or_pickled(wall_world) -> None:
+    expected = VoxelMap.covering(wall_world, 0.2)
+    readings = list(_frames_and_scans(wall_world))
+    for reading in readings:
+        _integrate(expected, reading)
+    voxel_map = VoxelMap.covering(wall_world, 0.2)
+    voxel_map.background = True
+    for reading in readings:
+        _integrate(voxel_map, reading)
+    copy = pickle.loads(pickle.dumps(voxel_map))
+    np.testing.assert_array_equal(copy.states, expected.states)
+    assert not copy.background  # an unpickled map integrates in place until told otherwise
+    fresh = VoxelMap.covering(wall_world, 0.2)
+    fresh.background = True
+    cells = fresh.states  # the array the walks will write into
+    for reading in readings:
+        _integrate(fresh, reading)
+    fresh.states = np.zeros_like(cells)  # replaced once the walks are done, not during
+    np.testing.assert_array_equal(cells, expected.states)
+    assert fresh.counts()["unknown"] == cells.size

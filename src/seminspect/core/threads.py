@@ -97,6 +97,13 @@ def thread_pool(threads: int) -> ThreadPoolExecutor:
     return ThreadPoolExecutor(threads, thread_name_prefix="seminspect")
 
 
+@cache
+def map_thread() -> ThreadPoolExecutor:
+    """One worker thread per process for map integration handed to the background, so that
+    integrations run one at a time, in the order they were handed over."""
+    return ThreadPoolExecutor(1, thread_name_prefix="seminspect-map")
+
+
 #: Blocks per thread when a batch is dealt out: enough that each thread gets a share of every
 #: part of an image or a scan, few enough that a block's call overhead stays negligible.
 BLOCKS_PER_THREAD = 8

@@ -120,7 +120,7 @@ def _walk(  # noqa: PLR0917 - scalars keep the per-ray walk free of allocations
         cells[last] = OCCUPIED if occupy_end else FREE
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def integrate_rays_kernel(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
     states: np.ndarray,
     grid_origin: np.ndarray,

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from concurrent.futures import Future
 from functools import lru_cache
 from pathlib import Path
 
@@ -25,7 +25,7 @@ from scipy.spatial.transform import Rotation
 
 from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.core.io import save_npz_atomic
-from seminspect.core.threads import rotate_rows
+from seminspect.core.threads import map_thread, rotate_rows
 from seminspect.geometry.raster import cells_touching_triangles
 from seminspect.geometry.transforms import as_point, as_points
 from seminspect.mapping import carving
@@ -44,7 +44,6 @@ MAP_FORMAT = "seminspect.voxel-map"
 MAP_VERSION = 1
 
 
-@dataclass
 class VoxelMap:
     """A dense occupancy grid.
 
@@ -53,20 +52,52 @@ class VoxelMap:
         resolution: edge length of a cell (metres).
         states: ``uint8`` array of shape ``(nx, ny, nz)`` holding UNKNOWN, FREE or OCCUPIED,
             kept C-ordered (a strided view is copied) so the ray walk can step through it flat.
+        background: walk integrated rays on a worker thread
+            (:func:`~seminspect.core.threads.map_thread`) while the caller goes on. Reading or
+            replacing :attr:`states` first waits for every walk handed over, and the walks run
+            in the order they were handed over, so every read sees the cells the same
+            integrations would have left in place. An array taken from :attr:`states` is the
+            live grid: read it before integrating more, not across an integration.
     """
 
-    origin: NDArray[np.float64]
-    resolution: float
-    states: NDArray[np.uint8]
+    def __init__(self, origin: ArrayLike, resolution: float, states: NDArray[np.uint8]) -> None:
+        self.origin = as_point(origin, "voxel map origin")
+        if not (math.isfinite(resolution) and resolution > 0):
+            raise InvalidInputError(f"voxel resolution must be > 0, got {resolution}")
+        self.resolution = float(resolution)
+        self._pending: list[Future[None]] = []
+        self.background = False
+        self.states = states
 
-    def __post_init__(self) -> None:
-        self.origin = as_point(self.origin, "voxel map origin")
-        if not (math.isfinite(self.resolution) and self.resolution > 0):
-            raise InvalidInputError(f"voxel resolution must be > 0, got {self.resolution}")
-        self.resolution = float(self.resolution)
-        if self.states.ndim != 3 or self.states.dtype != np.uint8:
+    @property
+    def states(self) -> NDArray[np.uint8]:
+        """The cells, once every integration handed to the worker thread has finished."""
+        self.settle()
+        return self._cells
+
+    @states.setter
+    def states(self, cells: NDArray[np.uint8]) -> None:
+        self.settle()
+        if cells.ndim != 3 or cells.dtype != np.uint8:
             raise InvalidInputError("voxel states must be a 3D uint8 array")
-        self.states = np.ascontiguousarray(self.states)
+        self._cells = np.ascontiguousarray(cells)
+
+    def settle(self) -> None:
+        """Wait for the rays handed to the worker thread to be walked into the map."""
+        pending, self._pending = self._pending, []
+        for walks in pending:
+            walks.result()
+
+    def __getstate__(self) -> dict[str, object]:
+        """Pickled (e.g. by Ray) with its cells settled and without the pending work."""
+        return {"origin": self.origin, "resolution": self.resolution, "cells": self.states}
+
+    def __setstate__(self, state: dict[str, object]) -> None:
+        VoxelMap.__init__(self, state["origin"], state["resolution"], state["cells"])  # type: ignore[arg-type]
+
+    def __repr__(self) -> str:
+        origin, shape = self.origin.tolist(), self.shape
+        return f"VoxelMap(origin={origin}, resolution={self.resolution}, shape={shape})"
 
     @classmethod
     def empty(cls, lower: ArrayLike, upper: ArrayLike, resolution: float) -> VoxelMap:
@@ -87,7 +118,7 @@ class VoxelMap:
 
     @property
     def shape(self) -> tuple[int, int, int]:
-        return self.states.shape  # type: ignore[return-value]
+        return self._cells.shape  # type: ignore[return-value]
 
     @property
     def upper(self) -> NDArray[np.float64]:
@@ -202,7 +233,21 @@ class VoxelMap:
         starts = np.zeros(0) if carve_from is None else np.asarray(carve_from, dtype=np.float64)
         if starts.size and starts.shape != (len(ends),):
             raise InvalidInputError(f"{starts.size} carving starts for {len(ends)} rays")
-        if len(ends):
+        if not len(ends):
+            return
+        if self.background:  # copies: the caller may reuse its arrays once this returns
+            walks = map_thread().submit(
+                integrate_rays_kernel,
+                self._cells,
+                self.origin,
+                self.resolution,
+                start.copy(),
+                ends.copy(),
+                flags.copy(),
+                starts.copy(),
+            )
+            self._pending.append(walks)
+        else:
             integrate_rays_kernel(
                 self.states, self.origin, self.resolution, start, ends, flags, starts
             )

@@ -73,6 +73,15 @@ def run_name(config: MissionConfig) -> str:
     return f"{world}{scenario}-seed{config.seed}"
 
 
+def mission_map(world: World, config: ResolvedMissionConfig) -> VoxelMap:
+    """The robot's empty occupancy map over ``world``; with a second core its rays are walked
+    into it on a worker thread while the mission goes on (the same map, see
+    :class:`~seminspect.mapping.voxel.VoxelMap`)."""
+    occupancy = VoxelMap.covering(world, config.map_resolution)
+    occupancy.background = sensor_threads() > 1
+    return occupancy
+
+
 def build_mission(
     config: ResolvedMissionConfig,
     run: RunDirectory | None,
@@ -82,7 +91,7 @@ def build_mission(
     """The world (made from ``config`` unless given), the robot in it and the executive."""
     world = world or open_world(config.world, config.scenario, seed=config.seed)
     platform, ground_z = build_platform(config, world)
-    occupancy = VoxelMap.covering(world, config.map_resolution)
+    occupancy = mission_map(world, config)
     executive = XFlie if inspects(config.planner) else FrontierMission
     mission = executive(config, platform, occupancy, ground_z=ground_z, run=run, progress=progress)
     return mission, world

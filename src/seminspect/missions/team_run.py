@@ -16,7 +16,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, replace
 
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
-from seminspect.mapping.voxel import VoxelMap
 from seminspect.missions.config import ResolvedMissionConfig
 from seminspect.missions.evaluation import DEFAULT_GATE_M, score_targets
 from seminspect.missions.metrics import (
@@ -33,6 +32,7 @@ from seminspect.missions.run import (
     build_platform,
     graph_figures,
     mission_figures,
+    mission_map,
     quality_figures,
     target_figures,
     truth_targets,
@@ -81,7 +81,7 @@ def build_team(
     frontiers the explorer would otherwise visit)."""
     graph: LayeredSemanticGraph | None = None
     missions: dict[str, XFlie] = {}
-    shared_map = VoxelMap.covering(world, config.map_resolution)
+    shared_map = mission_map(world, config)
     for role in ("explorer", "inspector"):
         platform, ground_z = build_platform(config, world, name=role)
         mission = XFlie(
