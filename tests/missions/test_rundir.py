@@ -8,9 +8,11 @@ import sys
 import time
 from pathlib import Path
 
+import cv2
+import numpy as np
 import pytest
 
-from seminspect.core.errors import InvalidInputError
+from seminspect.core.errors import InvalidInputError, SeminspectError
 from seminspect.core.provenance import code_version
 from seminspect.mapping.voxel import VoxelMap, save_map
 from seminspect.missions.config import make_config, resolve
@@ -19,6 +21,8 @@ from seminspect.missions.rundir import (
     RunDirectory,
     RunDirectoryInUseError,
     RunDirectoryWarning,
+    RunEnd,
+    conduct_run,
     load_robot_trajectories,
     load_trajectory,
     read_run_status,
@@ -167,3 +171,38 @@ def test_only_an_unfinished_run_can_be_resumed(tmp_path) -> None:
     assert resumable_config(failed) == config.model_dump(mode="json")
     with pytest.raises(InvalidInputError, match="not a run directory"):
         resumable_config(tmp_path)
+
+
+def test_view_images_are_written_on_a_worker_and_settled_before_the_outputs(tmp_path) -> None:
+    rng = np.random.default_rng(0)
+    images = [rng.integers(0, 255, (48, 64), dtype=np.uint8) for _ in range(5)]
+    seen_by_outputs: list[bool] = []
+
+    def work() -> str:
+        for index, image in enumerate(images):
+            assert run.write_image(f"car-1-{index:05d}", image) == f"images/car-1-{index:05d}.jpg"
+            image[:] = 0  # the caller may reuse its array at once
+        return "done"
+
+    def write_outputs(end: RunEnd) -> None:
+        seen_by_outputs.append(
+            all(run.path(f"images/car-1-{i:05d}.jpg").exists() for i in range(5))
+        )
+
+    with RunDirectory(tmp_path / "run").claimed(CONFIG) as run:
+        end = conduct_run(run, work, write_outputs, expected=(), what="mission")
+    assert end.state == "completed" and seen_by_outputs == [True]
+    decoded = cv2.imread(str(run.path("images/car-1-00004.jpg")), cv2.IMREAD_GRAYSCALE)
+    assert decoded.shape == (48, 64) and decoded.std() > 20  # the image, not the zeros after it
+
+
+def test_an_image_that_cannot_be_written_fails_the_run_in_one_line(tmp_path) -> None:
+    def work() -> str:
+        run.path("images").write_text("a file where the folder should be")
+        run.write_image("car-1-00000", np.zeros((8, 8), dtype=np.uint8))
+        return "done"
+
+    run = RunDirectory(tmp_path / "run")
+    with pytest.raises(SeminspectError, match="mission failed"), run.claimed(CONFIG):
+        conduct_run(run, work, lambda end: None, expected=(), what="mission")
+    assert read_run_status(run.root).state == "failed"

@@ -98,10 +98,10 @@ def thread_pool(threads: int) -> ThreadPoolExecutor:
 
 
 @cache
-def map_thread() -> ThreadPoolExecutor:
-    """One worker thread per process for map integration handed to the background, so that
-    integrations run one at a time, in the order they were handed over."""
-    return ThreadPoolExecutor(1, thread_name_prefix="seminspect-map")
+def serial_worker(purpose: str) -> ThreadPoolExecutor:
+    """One worker thread per process and ``purpose`` (``"map"``, ``"images"``): what is handed
+    to it runs one item at a time, in the order it was handed over."""
+    return ThreadPoolExecutor(1, thread_name_prefix=f"seminspect-{purpose}")
 
 
 #: Blocks per thread when a batch is dealt out: enough that each thread gets a share of every

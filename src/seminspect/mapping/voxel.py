@@ -25,7 +25,7 @@ from scipy.spatial.transform import Rotation
 
 from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.core.io import save_npz_atomic
-from seminspect.core.threads import map_thread, rotate_rows
+from seminspect.core.threads import rotate_rows, serial_worker
 from seminspect.geometry.raster import cells_touching_triangles
 from seminspect.geometry.transforms import as_point, as_points
 from seminspect.mapping import carving
@@ -53,7 +53,7 @@ class VoxelMap:
         states: ``uint8`` array of shape ``(nx, ny, nz)`` holding UNKNOWN, FREE or OCCUPIED,
             kept C-ordered (a strided view is copied) so the ray walk can step through it flat.
         background: walk integrated rays on a worker thread
-            (:func:`~seminspect.core.threads.map_thread`) while the caller goes on. Reading or
+            (:func:`~seminspect.core.threads.serial_worker`) while the caller goes on. Reading or
             replacing :attr:`states` first waits for every walk handed over, and the walks run
             in the order they were handed over, so every read sees the cells the same
             integrations would have left in place. An array taken from :attr:`states` is the
@@ -236,7 +236,7 @@ class VoxelMap:
         if not len(ends):
             return
         if self.background:  # copies: the caller may reuse its arrays once this returns
-            walks = map_thread().submit(
+            walks = serial_worker("map").submit(
                 integrate_rays_kernel,
                 self._cells,
                 self.origin,

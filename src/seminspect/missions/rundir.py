@@ -41,6 +41,7 @@ import threading
 import time
 import warnings
 from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import Future
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
@@ -59,6 +60,7 @@ from seminspect.core.io import (
     write_versioned_json,
 )
 from seminspect.core.provenance import code_differences, code_version
+from seminspect.core.threads import serial_worker
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.io import save_graph
 from seminspect.mapping.voxel import VoxelMap, save_map
@@ -121,6 +123,7 @@ class RunDirectory:
                 f"cannot create run directory {self.root} ({exc.strerror}); choose another --out"
             ) from None
         self._events: list[dict[str, Any]] = []
+        self._image_writes: list[Future[Path]] = []
         self._status_lock = threading.Lock()
         self._writer: dict[str, Any] | None = None  # pid, host, started while this process runs it
         self.finished = False
@@ -232,13 +235,24 @@ class RunDirectory:
         atomic_write_text(self.path(name), header + body)
 
     def write_image(self, name: str, image: NDArray[np.uint8]) -> str:
-        """Save a view image as JPEG; returns its path relative to the run directory."""
-        ok, encoded = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, 90])
-        if not ok:
-            raise InvalidInputError(f"could not encode image {name}")
+        """Save a view image as JPEG; returns its path relative to the run directory.
+
+        The image is encoded and written on a worker thread (``serial_worker("images")``) while
+        the mission goes on; :meth:`settle_images` waits for every image handed over, and
+        :func:`conduct_run` does so before the run's outputs and last status are written.
+        """
         relative = f"images/{name}.jpg"
-        atomic_write_bytes(self.path(relative), encoded.tobytes())
+        target = self.path(relative)
+        self._image_writes.append(
+            serial_worker("images").submit(_write_jpeg, target, name, image.copy())
+        )
         return relative
+
+    def settle_images(self) -> None:
+        """Wait for the images handed to the worker thread; the first failure is raised."""
+        pending, self._image_writes = self._image_writes, []
+        for write in pending:
+            write.result()
 
     def log_event(self, kind: str, sim_time: float, **fields: Any) -> None:
         """Record one decision; :meth:`flush_events` writes them all."""
@@ -269,6 +283,13 @@ class RunEnd:
         return self.stop.signum if self.stop else None
 
 
+def _write_jpeg(target: Path, name: str, image: NDArray[np.uint8]) -> Path:
+    ok, encoded = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, 90])
+    if not ok:
+        raise InvalidInputError(f"could not encode image {name}")
+    return atomic_write_bytes(target, encoded.tobytes())
+
+
 def conduct_run(
     run: RunDirectory,
     work: Callable[[], str],
@@ -284,12 +305,14 @@ def conduct_run(
     end = RunEnd()
     try:
         end.reason = work()
+        run.settle_images()
     except KeyboardInterrupt as exc:
         end.stop = as_interrupted(exc)
         end.state, end.reason = "interrupted", end.stop.describe()
     except Exception as exc:
         end.state, end.reason, end.error = "failed", f"{type(exc).__name__}: {exc}", exc
     try:
+        run.settle_images()  # those of work that stopped early
         write_outputs(end)
     except KeyboardInterrupt as exc:
         end.stop = end.stop or as_interrupted(exc)
