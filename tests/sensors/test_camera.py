@@ -51,6 +51,22 @@ def test_depth_is_measured_along_the_optical_axis(wall) -> None:
     assert points[:10, 1].mean() > 0 and frame.points()[:, 2].max() > 3.0
 
 
+def test_points_of_pixel_indices_equal_the_points_of_their_mask(wall) -> None:
+    frame = render(
+        wall, SMALL, (0.0, 0.0, 2.0), quat_from_yaw(0.3), odometry=((0, 1, 2), quat_from_yaw(0.2))
+    )
+    mask = np.random.default_rng(0).random(frame.shape) < 0.3
+    mask[: frame.shape[0] // 3] = True  # sky rows: pixels with no depth are dropped
+    for odometry in (False, True):
+        np.testing.assert_array_equal(
+            frame.pixel_points(np.flatnonzero(mask), use_odometry=odometry),
+            frame.points(mask, use_odometry=odometry),
+        )
+    assert frame.pixel_points(np.empty(0, int)).shape == (0, 3)
+    with pytest.raises(InvalidInputError, match="pixel indices"):
+        frame.pixel_points([frame.depth.size])
+
+
 def test_range_limit_and_pitch(wall) -> None:
     far = render(wall, CameraModel(160, 120, max_range=4.0), (0, 0, 2), quat_from_yaw(0.0))
     seen = np.isfinite(far.depth)

@@ -29,14 +29,31 @@ def detection_points(
     object that stands on it. A mask larger than ``MAX_MASK_POINTS`` pixels (a building that
     fills the image) is sampled on a regular pixel grid first.
     """
-    mask = erode_mask(detection.mask, erosion_px)
+    rows, cols = _mask_pixels(detection.mask, erosion_px)
     step = math.ceil(math.sqrt(detection.area_px / MAX_MASK_POINTS))
     if step > 1:
-        grid = np.zeros_like(mask)
-        grid[::step, ::step] = True
-        mask = mask & grid
-    points = frame.points(mask, use_odometry=True)
+        on_grid = (rows % step == 0) & (cols % step == 0)
+        rows, cols = rows[on_grid], cols[on_grid]
+    points = frame.pixel_points(rows * frame.shape[1] + cols, use_odometry=True)
     return points if min_height is None else points[points[:, 2] >= min_height]
+
+
+def _mask_pixels(mask: np.ndarray, erosion_px: int) -> tuple[np.ndarray, np.ndarray]:
+    """Rows and columns (row-major) of the mask's pixels left after erosion.
+
+    The erosion works in the mask's box grown by one pixel: the zeros around the mask stay
+    zeros and keep the crop's edge out of reach, and where the box meets the frame's edge
+    the crop's edge is the frame's, as it was for the whole mask.
+    """
+    height, width = mask.shape
+    rows = np.flatnonzero(mask.any(axis=1))
+    cols = np.flatnonzero(mask.any(axis=0))
+    if not rows.size:
+        return rows, cols
+    r0, c0 = max(int(rows[0]) - 1, 0), max(int(cols[0]) - 1, 0)
+    crop = mask[r0 : min(int(rows[-1]) + 2, height), c0 : min(int(cols[-1]) + 2, width)]
+    rows, cols = np.nonzero(erode_mask(crop, erosion_px))
+    return rows + r0, cols + c0
 
 
 def observe(

@@ -158,8 +158,22 @@ class Frame:
             if chosen.shape != self.shape:
                 raise InvalidInputError(f"mask shape {chosen.shape} != frame shape {self.shape}")
             valid &= chosen
+        return self._placed(np.flatnonzero(valid), use_odometry)
+
+    def pixel_points(self, pixels: ArrayLike, use_odometry: bool = False) -> NDArray:
+        """World points ``(N, 3)`` of the row-major pixel indices ``pixels`` that saw a surface.
+
+        The points of ``points(mask)`` when ``pixels`` are the mask's indices in order, without
+        a pass over the whole frame: what a caller that knows a small mask's pixels wants.
+        """
+        flat = np.asarray(pixels, dtype=np.intp).reshape(-1)
+        if flat.size and (flat.min() < 0 or flat.max() >= self.depth.size):
+            raise InvalidInputError(f"pixel indices must lie in [0, {self.depth.size})")
+        return self._placed(flat[np.isfinite(self.depth.ravel()[flat])], use_odometry)
+
+    def _placed(self, flat: NDArray[np.intp], use_odometry: bool) -> NDArray:
+        """World points of pixels known to have a finite depth."""
         directions, cosine = self.camera.rays
-        flat = np.flatnonzero(valid)
         scale = (self.depth.ravel()[flat] / cosine[flat])[:, None]
         body = directions[flat] * scale
         position, orientation = (
