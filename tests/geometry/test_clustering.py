@@ -5,6 +5,7 @@ import pytest
 from sklearn.cluster import DBSCAN
 
 from seminspect.core.errors import InvalidInputError
+from seminspect.geometry import clustering
 from seminspect.geometry.clustering import MIN_GRID_POINTS, dbscan_labels
 
 
@@ -68,6 +69,28 @@ def test_tiny_clouds(n: int, min_samples: int) -> None:
     rng = np.random.default_rng(n)
     _assert_same_as_sklearn(rng.uniform(0, 1, (n, 3)), 0.4, min_samples)
     _assert_same_as_sklearn(np.zeros((n, 3)), 0.4, min_samples)
+
+
+@pytest.mark.parametrize("eps", [0.3, 0.1, 0.7])
+def test_tiny_clouds_with_pairs_exactly_eps_apart(eps: float) -> None:
+    line = np.column_stack([np.arange(6) * eps, np.zeros(6), np.zeros(6)]) + 100.0
+    for min_samples in (1, 2, 3):
+        _assert_same_as_sklearn(line, eps, min_samples)
+
+
+def test_tiny_clouds_go_to_sklearn_only_near_a_tie(monkeypatch) -> None:
+    calls = []
+    monkeypatch.setattr(clustering, "_sklearn_labels", lambda *args: calls.append(args))
+    rng = np.random.default_rng(5)
+    for _ in range(50):
+        dbscan_labels(rng.uniform(0, 1, (8, 3)), 0.4, 3)
+    assert not calls
+    dbscan_labels(np.array([[0.0, 0, 0], [0.3, 0, 0], [5, 5, 5]]), 0.3, 2)
+    assert len(calls) == 1
+
+
+def test_an_empty_cloud_has_no_labels() -> None:
+    assert dbscan_labels(np.empty((0, 3)), 0.5, 5).shape == (0,)
 
 
 def test_min_samples_equal_to_and_above_the_cloud_size() -> None:

@@ -1,8 +1,9 @@
 """DBSCAN of 3D point clouds, compiled: the labels of scikit-learn's, without its overhead.
 
 ``dbscan_labels(points, eps, min_samples)`` returns what
-``sklearn.cluster.DBSCAN(eps=eps, min_samples=min_samples).fit_predict(points)`` returns for
-clouds of 12 or more points, where scikit-learn answers its radius queries from a KD-tree:
+``sklearn.cluster.DBSCAN(eps=eps, min_samples=min_samples).fit_predict(points)`` returns. For
+clouds of 12 or more points scikit-learn answers its radius queries from a KD-tree, and this
+module follows the same rules:
 
 - the neighbours of a point are the points ``q`` (itself included) whose squared distance
   ``sum((p - q) ** 2)``, summed over x, y, z in that order, is at most ``eps * eps``;
@@ -11,10 +12,11 @@ clouds of 12 or more points, where scikit-learn answers its radius queries from 
   completely before the next starts, so a border point within reach of two clusters joins the
   lower-numbered one; everything else is noise (-1).
 
-Smaller clouds are handed to scikit-learn itself: it measures their distances by matrix product
-(``|p|^2 - 2 p.q + |q|^2``), whose rounding can differ from the sum above for a pair exactly
-``eps`` apart. Neighbours are found on a grid of cells at least ``eps`` wide, so only the 27
-cells around a point are searched.
+For smaller clouds scikit-learn measures distances by matrix product (``|p|^2 - 2 p.q +
+|q|^2``), whose rounding can differ from the sum above for a pair within rounding of ``eps``:
+such a cloud, and only such a cloud, is handed to scikit-learn itself (importing it takes a
+second and a half, so it is not done for the clouds that do not need it). Neighbours are found
+on a grid of cells at least ``eps`` wide, so only the 27 cells around a point are searched.
 """
 
 from __future__ import annotations
@@ -29,6 +31,10 @@ from seminspect.core.errors import InvalidInputError
 
 #: Below this many points scikit-learn measures distances by matrix product (its brute force).
 MIN_GRID_POINTS = 12
+#: A squared distance this close to ``eps^2``, relative to the squared norms it is computed
+#: from, may round to either side of it in a matrix product (thousands of times the error
+#: bound of a three-term product).
+_TIE_TOLERANCE = 1e-12
 #: Cells per axis at most, so that a cell's linear key fits an int64.
 _MAX_CELLS_PER_AXIS = 2**20
 #: Cells are this much wider than ``eps`` so that rounding in the cell index never separates
@@ -47,12 +53,23 @@ def dbscan_labels(points: ArrayLike, eps: float, min_samples: int) -> NDArray[np
         raise InvalidInputError(f"DBSCAN eps must be > 0, got {eps}")
     if not (isinstance(min_samples, int | np.integer) and min_samples >= 1):
         raise InvalidInputError(f"DBSCAN min_samples must be a positive integer, got {min_samples}")
-    if len(cloud) < MIN_GRID_POINTS:
+    if not len(cloud):
+        return np.empty(0, np.int64)
+    if len(cloud) < MIN_GRID_POINTS and _has_pair_near_eps(cloud, eps):
         return _sklearn_labels(cloud, eps, int(min_samples))
     low = cloud.min(axis=0)
     span = float((cloud.max(axis=0) - low).max())
     cell = max(eps * _CELL_SLACK, span / (_MAX_CELLS_PER_AXIS - 2))
     return _dbscan_grid(cloud, low, cell, eps * eps, int(min_samples))
+
+
+def _has_pair_near_eps(cloud: NDArray[np.float64], eps: float) -> bool:
+    """Whether two points (or a point and itself) lie so close to ``eps`` apart that a matrix
+    product might put them on the other side of it than the exact sum does."""
+    squared = ((cloud[:, None, :] - cloud[None, :, :]) ** 2).sum(axis=2)
+    norms = (cloud**2).sum(axis=1)
+    tolerance = _TIE_TOLERANCE * (norms[:, None] + norms[None, :] + eps * eps)
+    return bool(np.any(np.abs(squared - eps * eps) <= tolerance))
 
 
 def _sklearn_labels(cloud: NDArray[np.float64], eps: float, min_samples: int) -> NDArray[np.int64]:
