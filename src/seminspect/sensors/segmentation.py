@@ -152,8 +152,7 @@ def _keys(frame: Frame, world: World, level: Level, classes, parts) -> tuple[NDA
     if level == "instance":
         key = frame.instance.astype(np.int64)
     else:
-        key = frame.instance.astype(np.int64) * stride + frame.part_id
-        key[frame.part_id == 0] = 0
+        key = _part_keys(frame.instance, frame.part_id, stride)
     candidates = []
     for value in distinct_positive(key).tolist():
         inst = value if level == "instance" else value // stride
@@ -164,6 +163,19 @@ def _keys(frame: Frame, world: World, level: Level, classes, parts) -> tuple[NDA
         if level == "instance" or wanted_parts is None or label in wanted_parts:
             candidates.append((value, label, inst))
     return key, candidates
+
+
+@numba.njit(cache=True)
+def _part_keys(
+    instance: NDArray[np.int32], part_id: NDArray[np.int16], stride: int
+) -> NDArray[np.int64]:
+    """``instance * stride + part_id`` per pixel, 0 where there is no part: one pass."""
+    key = np.zeros(instance.shape, np.int64)
+    for r in range(instance.shape[0]):
+        for c in range(instance.shape[1]):
+            if part_id[r, c] != 0:
+                key[r, c] = np.int64(instance[r, c]) * stride + part_id[r, c]
+    return key
 
 
 def detect(
