@@ -57,10 +57,7 @@ def dbscan_labels(points: ArrayLike, eps: float, min_samples: int) -> NDArray[np
         return np.empty(0, np.int64)
     if len(cloud) < MIN_GRID_POINTS and _has_pair_near_eps(cloud, eps):
         return _sklearn_labels(cloud, eps, int(min_samples))
-    low = cloud.min(axis=0)
-    span = float((cloud.max(axis=0) - low).max())
-    cell = max(eps * _CELL_SLACK, span / (_MAX_CELLS_PER_AXIS - 2))
-    return _dbscan_grid(cloud, low, cell, eps * eps, int(min_samples))
+    return _grid_labels(cloud, eps, int(min_samples))
 
 
 def _has_pair_near_eps(cloud: NDArray[np.float64], eps: float) -> bool:
@@ -79,33 +76,40 @@ def _sklearn_labels(cloud: NDArray[np.float64], eps: float, min_samples: int) ->
     return labels.astype(np.int64)
 
 
-@numba.njit(cache=True)
-def _dbscan_grid(cloud, low, cell, eps2, min_samples):  # pragma: no cover - compiled
-    n = cloud.shape[0]
-    index = np.empty((n, 3), np.int64)
-    for i in range(n):
-        for j in range(3):
-            index[i, j] = math.floor((cloud[i, j] - low[j]) / cell)
-    dims = np.empty(3, np.int64)
-    for j in range(3):
-        dims[j] = index[:, j].max() + 1
+def _grid_labels(cloud: NDArray[np.float64], eps: float, min_samples: int) -> NDArray[np.int64]:
+    """Labels from the points sorted by cell: a cell's points are contiguous, so the compiled
+    distance loops read memory in order."""
+    low = cloud.min(axis=0)
+    span = float((cloud.max(axis=0) - low).max())
+    cell = max(eps * _CELL_SLACK, span / (_MAX_CELLS_PER_AXIS - 2))
+    index = np.floor((cloud - low) / cell).astype(np.int64)
+    dims = index.max(axis=0) + 1
     keys = (index[:, 0] * dims[1] + index[:, 1]) * dims[2] + index[:, 2]
-    # Sorted by cell, a cell's points are contiguous and the distance loops read memory in order.
-    order = np.argsort(keys, kind="mergesort")
-    keys, index, points = keys[order], index[order], cloud[order]
-    first = np.ones(n, np.bool_)
-    first[1:] = keys[1:] != keys[:-1]
-    cell_start = np.append(np.flatnonzero(first), n)
-    cell_keys = keys[first]
-    point_cell = np.cumsum(first) - 1
-    grid = (points, index, dims, cell_keys, cell_start)
-    core = np.empty(n, np.bool_)
-    for i in range(n):
+    order = np.argsort(keys, kind="stable")
+    cell_keys, cell_start, point_cell = np.unique(
+        keys[order], return_index=True, return_inverse=True
+    )
+    grid = (
+        cloud[order],
+        index[order],
+        dims,
+        cell_keys,
+        np.append(cell_start, len(cloud)).astype(np.int64),
+    )
+    core = _core_points(grid, eps * eps, min_samples)
+    # Seeds are taken in the caller's order: their positions in the sorted points, by index.
+    seeds = np.argsort(order)
+    labels = np.empty(len(cloud), np.int64)
+    labels[order] = _expand(grid, point_cell.astype(np.int64), core, seeds, eps * eps)
+    return labels
+
+
+@numba.njit(cache=True)
+def _core_points(grid, eps2, min_samples):  # pragma: no cover - compiled
+    core = np.empty(len(grid[0]), np.bool_)
+    for i in range(len(core)):
         core[i] = _is_core(grid, i, eps2, min_samples)
-    labels = _expand(grid, point_cell, core, order, eps2)
-    result = np.empty(n, np.int64)
-    result[order] = labels
-    return result
+    return core
 
 
 @numba.njit(cache=True)
@@ -118,9 +122,22 @@ def _cells_near(grid, i, x, y):  # pragma: no cover - compiled
     column = (x * dims[1] + y) * dims[2]
     z_low = max(index[i, 2] - 1, 0)
     z_high = min(index[i, 2] + 1, dims[2] - 1)
-    first = np.searchsorted(cell_keys, column + z_low, side="left")
-    last = np.searchsorted(cell_keys, column + z_high, side="right")
-    return first, last
+    return _first_at_least(cell_keys, column + z_low), _first_at_least(
+        cell_keys, column + z_high + 1
+    )
+
+
+@numba.njit(cache=True)
+def _first_at_least(keys, key):  # pragma: no cover - compiled
+    """The first position in the sorted ``keys`` whose key is at least ``key``."""
+    low, high = 0, len(keys)
+    while low < high:
+        middle = (low + high) // 2
+        if keys[middle] < key:
+            low = middle + 1
+        else:
+            high = middle
+    return low
 
 
 @numba.njit(cache=True)
@@ -148,7 +165,7 @@ def _is_core(grid, i, eps2, min_samples):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _expand(grid, point_cell, core, order, eps2):  # pragma: no cover - compiled
+def _expand(grid, point_cell, core, seeds, eps2):  # pragma: no cover - compiled
     """Clusters grown from each unlabelled core point in original index order.
 
     A cell whose points are all labelled is skipped without measuring a distance: inside a
@@ -160,7 +177,7 @@ def _expand(grid, point_cell, core, order, eps2):  # pragma: no cover - compiled
     unlabelled = cell_start[1:] - cell_start[:-1]
     stack = np.empty(n, np.int64)
     cluster = 0
-    for seed in np.argsort(order):  # sorted positions, visited in original index order
+    for seed in seeds:
         if labels[seed] != -1 or not core[seed]:
             continue
         labels[seed] = cluster
