@@ -9,8 +9,8 @@ see the same machine load, it times:
   mask worked on in its box grown by the bleed, against every step on whole-frame masks
   (``whole_frame_detect`` below);
 * ``detection_points``: a detection's points after the mission's 2-pixel erosion, eroded in
-  the mask's box and placed from its pixel indices, against whole-frame erosion and
-  ``Frame.points`` on the whole mask;
+  the mask's box and placed from its pixel indices by a compiled loop, against whole-frame
+  erosion and the numpy back-projection of the whole mask;
 * clustering: ``geometry.clustering.dbscan_labels`` against scikit-learn's ``DBSCAN`` on each
   detection's points (at most ``CLUSTER_POINTS``, sampled as localisation samples them).
 
@@ -30,9 +30,11 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 from sklearn.cluster import DBSCAN
 
 from seminspect.core.rng import make_rng
+from seminspect.core.threads import rotate_rows
 from seminspect.geometry.clustering import dbscan_labels
 from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.perception.detections import MAX_MASK_POINTS, detection_points
@@ -95,7 +97,11 @@ def whole_frame_points(frame: Frame, detection: Detection) -> np.ndarray:
         grid = np.zeros_like(mask)
         grid[::step, ::step] = True
         mask = mask & grid
-    return frame.points(mask, use_odometry=True)
+    flat = np.flatnonzero(mask & np.isfinite(frame.depth))
+    directions, cosine = frame.camera.rays
+    body = directions[flat] * (frame.depth.ravel()[flat] / cosine[flat])[:, None]
+    rotation = Rotation.from_quat(frame.odometry_orientation).as_matrix()
+    return rotate_rows(body, rotation) + frame.odometry_position
 
 
 def sampled(points: np.ndarray) -> np.ndarray:
