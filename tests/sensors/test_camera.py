@@ -7,6 +7,7 @@ from scipy.spatial.transform import Rotation
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.params import preset
 from seminspect.core.rng import make_rng
+from seminspect.core.threads import rotate_rows
 from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.sensors import CameraModel, NoiseModel, noise_preset, render
 from seminspect.sensors.noise import NormalStream, make_noise
@@ -49,6 +50,35 @@ def test_depth_is_measured_along_the_optical_axis(wall) -> None:
     np.testing.assert_allclose(points[:, 0], 5.0, atol=1e-4)
     # the image's left edge sees +y, its top edge sees +z
     assert points[:10, 1].mean() > 0 and frame.points()[:, 2].max() > 3.0
+
+
+def test_points_of_pixel_indices_equal_the_points_of_their_mask(wall) -> None:
+    frame = render(
+        wall, SMALL, (0.0, 0.0, 2.0), quat_from_yaw(0.3), odometry=((0, 1, 2), quat_from_yaw(0.2))
+    )
+    mask = np.random.default_rng(0).random(frame.shape) < 0.3
+    mask[: frame.shape[0] // 3] = True  # sky rows: pixels with no depth are dropped
+    for odometry in (False, True):
+        np.testing.assert_array_equal(
+            frame.pixel_points(np.flatnonzero(mask), use_odometry=odometry),
+            frame.points(mask, use_odometry=odometry),
+        )
+    assert frame.pixel_points(np.empty(0, int)).shape == (0, 3)
+    with pytest.raises(InvalidInputError, match="pixel indices"):
+        frame.pixel_points([frame.depth.size])
+
+
+@pytest.mark.parametrize("depth_dtype", [np.float32, np.float64])
+def test_points_equal_the_numpy_back_projection(wall, depth_dtype) -> None:
+    frame = render(wall, SMALL, (0.0, 0.2, 2.0), quat_from_yaw(0.4))
+    frame.depth = frame.depth.astype(depth_dtype)
+    valid = np.isfinite(frame.depth) & (np.random.default_rng(1).random(frame.shape) < 0.5)
+    flat = np.flatnonzero(valid)
+    directions, cosine = frame.camera.rays
+    body = directions[flat] * (frame.depth.ravel()[flat] / cosine[flat])[:, None]
+    rotation = Rotation.from_quat(frame.orientation).as_matrix()
+    expected = rotate_rows(body, rotation) + frame.position
+    np.testing.assert_array_equal(frame.points(valid), expected)
 
 
 def test_range_limit_and_pitch(wall) -> None:

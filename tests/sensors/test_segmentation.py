@@ -1,5 +1,7 @@
+import dataclasses
 import math
 
+import cv2
 import numpy as np
 import pytest
 
@@ -7,7 +9,7 @@ from seminspect.core.errors import InvalidInputError
 from seminspect.core.rng import make_rng
 from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.sensors import CameraModel, detect, detect_instances, detect_parts, render
-from seminspect.sensors.noise import make_noise
+from seminspect.sensors.noise import NoiseModel, make_noise
 from seminspect.sensors.segmentation import distinct_positive
 from seminspect.worlds import WorldBuilder
 from seminspect.worlds.shapes import pose_matrix
@@ -138,3 +140,67 @@ def test_distinct_positive_matches_numpy_unique() -> None:
     for values in (small, large, np.zeros((4, 4), dtype=np.int64)):
         expected = np.unique(values[values > 0])
         np.testing.assert_array_equal(distinct_positive(values), expected)
+
+
+def _random_labels(scene, seed: int):
+    """The scene's frame with random blobs of its car and truck, and of parts, some touching
+    the frame's edges, and random depths with holes."""
+    world, frame = scene
+    rng = np.random.default_rng(seed)
+    height, width = frame.shape
+    instance = np.zeros((height, width), np.int32)
+    part = np.zeros((height, width), np.int16)
+    for _ in range(int(rng.integers(3, 12))):
+        inst = int(rng.choice(list(world.instances)))
+        centre = (int(rng.integers(-10, width + 10)), int(rng.integers(-10, height + 10)))
+        axes = (int(rng.integers(1, 40)), int(rng.integers(1, 40)))
+        blob = np.zeros((height, width), np.uint8)
+        cv2.ellipse(blob, centre, axes, float(rng.uniform(0, 180)), 0, 360, 1, -1)
+        instance[blob > 0] = inst
+        part[blob > 0] = int(rng.integers(0, len(world.part_names)))
+    instance[rng.random((height, width)) < 0.01] = 0  # specks of background inside masks
+    part[instance == 0] = 0
+    depth = rng.uniform(1, 30, (height, width)).astype(np.float32)
+    depth[rng.random((height, width)) < 0.05] = np.inf
+    return dataclasses.replace(frame, instance=instance, part_id=part, depth=depth)
+
+
+def _whole_frame_masks(frame, world, level, noise):
+    """(mask, median depth) of every candidate, each step on whole-frame masks: the oracle."""
+    key = frame.instance.astype(np.int64)
+    if level == "part":
+        key = key * len(world.part_names) + frame.part_id
+        key[frame.part_id == 0] = 0
+    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (3, 3))
+    result = []
+    for value in np.unique(key[key > 0]):
+        shaped = (key == value).astype(np.uint8)
+        if noise.mask_erosion_px:
+            shaped = cv2.erode(shaped, kernel, iterations=noise.mask_erosion_px)
+        mask = shaped.astype(bool)
+        if noise.mask_bleed_px:
+            grown = cv2.dilate(shaped, kernel, iterations=noise.mask_bleed_px).astype(bool)
+            mask |= grown & (frame.instance == 0)
+        if mask.sum() >= noise.min_mask_area_px:
+            depths = frame.depth[mask]
+            depths = depths[np.isfinite(depths)]
+            result.append((mask, float(np.median(depths)) if len(depths) else math.inf))
+    return result
+
+
+@pytest.mark.parametrize("seed", range(12))
+@pytest.mark.parametrize("level", ["instance", "part"])
+@pytest.mark.parametrize(("erosion", "bleed"), [(0, 0), (2, 2), (1, 4), (3, 0), (0, 3)])
+def test_masks_cut_from_their_boxes_equal_whole_frame_masks(scene, seed, level, erosion, bleed):
+    world, _ = scene
+    frame = _random_labels(scene, seed)
+    noise = NoiseModel(mask_erosion_px=erosion, mask_bleed_px=bleed, min_mask_area_px=2)
+    found = detect(frame, world, level, noise=noise, rng=make_rng(seed, "test"))
+    expected = _whole_frame_masks(frame, world, level, noise)
+    assert len(found) == len(expected)
+    for detection, (mask, depth) in zip(found, expected, strict=True):
+        np.testing.assert_array_equal(detection.mask, mask)
+        assert detection.area_px == mask.sum()
+        assert detection.depth_m == depth
+        rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+        assert detection.bbox == (cols[0], rows[0], cols[-1] + 1, rows[-1] + 1)

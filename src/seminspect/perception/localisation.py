@@ -14,9 +14,9 @@ from typing import Literal
 import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from sklearn.cluster import DBSCAN
 
 from seminspect.core.errors import InvalidInputError
+from seminspect.geometry.clustering import dbscan_labels
 
 Method = Literal["median", "cluster"]
 #: Clustering runs on at most this many points (evenly sampled): enough to find the object.
@@ -62,7 +62,7 @@ def _largest_cluster(
     if len(cloud) > CLUSTER_POINTS:
         step = len(cloud) // CLUSTER_POINTS + 1
         cloud = cloud[::step]
-    labels = DBSCAN(eps=eps, min_samples=min_points).fit_predict(cloud)
+    labels = dbscan_labels(cloud, eps, min_points)
     kept = labels[labels >= 0]
     if kept.size == 0:
         return cloud

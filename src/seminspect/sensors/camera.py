@@ -158,16 +158,53 @@ class Frame:
             if chosen.shape != self.shape:
                 raise InvalidInputError(f"mask shape {chosen.shape} != frame shape {self.shape}")
             valid &= chosen
+        return self._placed(np.flatnonzero(valid), use_odometry)
+
+    def pixel_points(self, pixels: ArrayLike, use_odometry: bool = False) -> NDArray:
+        """World points ``(N, 3)`` of the row-major pixel indices ``pixels`` that saw a surface.
+
+        The points of ``points(mask)`` when ``pixels`` are the mask's indices in order, without
+        a pass over the whole frame: what a caller that knows a small mask's pixels wants.
+        """
+        flat = np.asarray(pixels, dtype=np.intp).reshape(-1)
+        if flat.size and (flat.min() < 0 or flat.max() >= self.depth.size):
+            raise InvalidInputError(f"pixel indices must lie in [0, {self.depth.size})")
+        return self._placed(flat, use_odometry)
+
+    def _placed(self, flat: NDArray[np.intp], use_odometry: bool) -> NDArray:
+        """World points of the pixels ``flat`` that have a finite depth."""
         directions, cosine = self.camera.rays
-        flat = np.flatnonzero(valid)
-        scale = (self.depth.ravel()[flat] / cosine[flat])[:, None]
-        body = directions[flat] * scale
+        depth = self.depth.reshape(-1)
+        # The dtypes numpy gives depth / cosine and directions * that, as before this kernel.
+        scale = np.empty(len(flat), np.result_type(depth, cosine))
+        body = np.empty((len(flat), 3), np.result_type(directions, scale))
+        hits = _hit_rays(depth, cosine, directions, flat, scale, body)
         position, orientation = (
             (self.odometry_position, self.odometry_orientation)
             if use_odometry
             else (self.position, self.orientation)
         )
-        return rotate_rows(body, Rotation.from_quat(orientation).as_matrix()) + position
+        points = rotate_rows(body[:hits], Rotation.from_quat(orientation).as_matrix())
+        points += position  # in place: the same sums without another array
+        return points
+
+
+@numba.njit(cache=True)
+def _hit_rays(depth, cosine, directions, flat, scale, body):  # noqa: PLR0917 - a compiled kernel
+    """Body-frame points ``directions * depth / cosine`` of the pixels ``flat`` whose depth is
+    finite, in order, into ``body``; returns how many.
+
+    Each quotient is stored (rounded to ``scale``'s dtype) before it multiplies, as in the
+    numpy expression ``directions[flat] * (depth[flat] / cosine[flat])[:, None]``.
+    """
+    hits = 0
+    for pixel in flat:
+        if np.isfinite(depth[pixel]):
+            scale[hits] = depth[pixel] / cosine[pixel]
+            for axis in range(3):
+                body[hits, axis] = directions[pixel, axis] * scale[hits]
+            hits += 1
+    return hits
 
 
 def render(

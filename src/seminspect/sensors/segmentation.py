@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 import cv2
+import numba
 import numpy as np
 from numpy.typing import NDArray
 
@@ -55,16 +56,64 @@ class Detection:
         return self.instance_id < 0
 
 
-def _bbox(mask: NDArray[np.bool_]) -> tuple[int, int, int, int]:
-    rows = np.flatnonzero(mask.any(axis=1))
-    cols = np.flatnonzero(mask.any(axis=0))
+Window = tuple[slice, slice]
+_WHOLE: Window = (slice(0, None), slice(0, None))
+
+
+def _bbox(mask: NDArray[np.bool_], window: Window = _WHOLE) -> tuple[int, int, int, int]:
+    """The box of a mask cut out of a frame at ``window``, in frame pixels."""
+    rows = np.flatnonzero(mask.any(axis=1)) + window[0].start
+    cols = np.flatnonzero(mask.any(axis=0)) + window[1].start
     return int(cols[0]), int(rows[0]), int(cols[-1]) + 1, int(rows[-1]) + 1
 
 
-def _median_depth(frame: Frame, mask: NDArray[np.bool_]) -> float:
-    values = frame.depth[mask]
+def _median_depth(depth: NDArray[np.float32], mask: NDArray[np.bool_]) -> float:
+    values = depth[mask]
     values = values[np.isfinite(values)]
     return float(np.median(values)) if len(values) else math.inf
+
+
+@numba.njit(cache=True)
+def _boxes(key: NDArray[np.int64], values: NDArray[np.int64]) -> NDArray[np.int64]:
+    """Rows and columns ``[r0, c0, r1, c1)`` spanned by each of the sorted ``values`` in ``key``.
+
+    One pass over the frame for every candidate at once; a value absent from ``key`` gets an
+    empty box.
+    """
+    height, width = key.shape
+    boxes = np.empty((len(values), 4), np.int64)
+    boxes[:, 0], boxes[:, 1], boxes[:, 2], boxes[:, 3] = height, width, 0, 0
+    last_value, last_slot = np.int64(0), -1
+    for r in range(height):
+        for c in range(width):
+            value = key[r, c]
+            if value <= 0:
+                continue
+            if value != last_value:  # runs of one label are the rule along a row
+                last_value = value
+                last_slot = np.searchsorted(values, value)
+                if last_slot == len(values) or values[last_slot] != value:
+                    last_slot = -1
+            if last_slot >= 0:
+                box = boxes[last_slot]
+                box[0], box[1] = min(box[0], r), min(box[1], c)
+                box[2], box[3] = max(box[2], r + 1), max(box[3], c + 1)
+    return boxes
+
+
+def _window(box: NDArray[np.int64], margin: int, shape: tuple[int, int]) -> Window:
+    """``box`` grown by ``margin`` pixels on every side, within the frame."""
+    r0, c0, r1, c1 = (int(b) for b in box)
+    return (
+        slice(max(r0 - margin, 0), min(r1 + margin, shape[0])),
+        slice(max(c0 - margin, 0), min(c1 + margin, shape[1])),
+    )
+
+
+def _in_frame(mask: NDArray[np.bool_], window: Window, shape: tuple[int, int]) -> NDArray[np.bool_]:
+    full = np.zeros(shape, dtype=bool)
+    full[window] = mask
+    return full
 
 
 def _distort(mask: NDArray[np.bool_], background: NDArray[np.bool_], noise: NoiseModel):
@@ -103,8 +152,7 @@ def _keys(frame: Frame, world: World, level: Level, classes, parts) -> tuple[NDA
     if level == "instance":
         key = frame.instance.astype(np.int64)
     else:
-        key = frame.instance.astype(np.int64) * stride + frame.part_id
-        key[frame.part_id == 0] = 0
+        key = _part_keys(frame.instance, frame.part_id, stride)
     candidates = []
     for value in distinct_positive(key).tolist():
         inst = value if level == "instance" else value // stride
@@ -115,6 +163,19 @@ def _keys(frame: Frame, world: World, level: Level, classes, parts) -> tuple[NDA
         if level == "instance" or wanted_parts is None or label in wanted_parts:
             candidates.append((value, label, inst))
     return key, candidates
+
+
+@numba.njit(cache=True)
+def _part_keys(
+    instance: NDArray[np.int32], part_id: NDArray[np.int16], stride: int
+) -> NDArray[np.int64]:
+    """``instance * stride + part_id`` per pixel, 0 where there is no part: one pass."""
+    key = np.zeros(instance.shape, np.int64)
+    for r in range(instance.shape[0]):
+        for c in range(instance.shape[1]):
+            if part_id[r, c] != 0:
+                key[r, c] = np.int64(instance[r, c]) * stride + part_id[r, c]
+    return key
 
 
 def detect(
@@ -141,22 +202,30 @@ def detect(
     model = noise or NoiseModel()
     generator = None if model.is_ideal else require_rng(rng)
     key, candidates = _keys(frame, world, level, classes, parts)
-    background = frame.instance == 0
+    boxes = _boxes(key, np.array([value for value, _, _ in candidates], dtype=np.int64))
+    # Each mask is worked on in its box grown by more than the bleed: the pixels around it are
+    # background-free zeros, so erosion and dilation see what they would see in the whole
+    # frame, and where the box meets the frame's edge the window's edge is the frame's.
+    margin = model.mask_bleed_px + 1
     detections = []
-    for value, label, inst in candidates:
-        mask = key == value
+    for (value, label, inst), box in zip(candidates, boxes, strict=True):
+        window = _window(box, margin, frame.shape)
+        mask = key[window] == value
         if generator is not None:
-            mask = _distort(mask, background, model)
-        area = int(mask.sum())
+            mask = _distort(mask, frame.instance[window] == 0, model)
+        area = int(np.count_nonzero(mask))
         if area < model.min_mask_area_px:
             continue
-        depth = _median_depth(frame, mask)
+        depth = _median_depth(frame.depth[window], mask)
         if generator is not None and generator.random() < model.miss_chance(depth, area):
             continue
         score = model.score_mean
         if generator is not None and model.score_sigma:
             score = float(np.clip(generator.normal(model.score_mean, model.score_sigma), 0.01, 1.0))
-        detections.append(Detection(label, mask, area, score, _bbox(mask), inst, level, depth))
+        full = _in_frame(mask, window, frame.shape)
+        detections.append(
+            Detection(label, full, area, score, _bbox(mask, window), inst, level, depth)
+        )
     if generator is not None and model.false_positives_per_frame:
         labels = _false_positive_labels(world, level, classes, parts)
         detections += _false_positives(frame, labels, level, model, generator)
@@ -219,6 +288,8 @@ def _false_positives(
         label = labels[int(rng.integers(len(labels)))]
         area = int(mask.sum())
         result.append(
-            Detection(label, mask, area, score, _bbox(mask), -1, level, _median_depth(frame, mask))
+            Detection(
+                label, mask, area, score, _bbox(mask), -1, level, _median_depth(frame.depth, mask)
+            )
         )
     return result

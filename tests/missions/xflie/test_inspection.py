@@ -1,4 +1,6 @@
 import numpy as np
+import pytest
+from scipy import ndimage
 
 from fake_platform import FakePlatform, fake_context
 from seminspect.graphs.lsg.model import TargetStatus
@@ -94,3 +96,14 @@ def test_a_mask_grows_by_four_connected_steps() -> None:
     grown = dilate(mask, 2)
     assert grown.sum() == 13  # a diamond of radius 2
     assert grown[4, 6] and grown[2, 4] and not grown[6, 6]
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_dilation_equals_scipys_binary_dilation(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    mask = rng.random((48, 64)) < rng.uniform(0.001, 0.2)
+    mask[:, 0] |= rng.random(48) < 0.3  # pixels on the image's edges
+    mask[-1] |= rng.random(64) < 0.3
+    for pixels in (0, 1, 2, 5):
+        expected = ndimage.binary_dilation(mask, iterations=pixels) if pixels else mask
+        np.testing.assert_array_equal(dilate(mask, pixels), expected)

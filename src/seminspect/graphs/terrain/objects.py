@@ -13,7 +13,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from sklearn.cluster import DBSCAN
 
 from seminspect.graphs.terrain.prompting import TaskPoints
 
@@ -50,6 +49,9 @@ def cluster_points(
     """DBSCAN cluster id of each point (-1 = noise), on count-weighted voxel centroids."""
     if points.shape[0] == 0:
         return np.zeros(0, dtype=np.int64)
+    # Loaded here: every mission imports this module, few of them cluster terrain objects.
+    from sklearn.cluster import DBSCAN  # noqa: PLC0415 - a second and a half to import
+
     centroids, inverse, counts = voxel_groups(points, voxel)
     labels = DBSCAN(eps=eps, min_samples=min_points).fit(centroids, sample_weight=counts).labels_
     return labels[inverse].astype(np.int64)

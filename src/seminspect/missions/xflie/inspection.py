@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import math
 
+import cv2
 import numpy as np
 from numpy.typing import NDArray
-from scipy import ndimage
 
 from seminspect.core.params import InspectionParams
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
@@ -137,7 +137,7 @@ class LevelInspection:
             features = [
                 observe(frame, p, image=image, method="median")
                 for p in parts
-                if (p.mask & grown).sum() >= PART_OVERLAP * p.area_px
+                if np.count_nonzero(p.mask & grown) >= PART_OVERLAP * p.area_px
             ]
         with ctx.timers("graph"):
             for z in features:
@@ -200,8 +200,16 @@ class LevelInspection:
 
 
 def dilate(mask: NDArray[np.bool_], pixels: int) -> NDArray[np.bool_]:
-    """Grow a mask by ``pixels`` 4-connected steps (a diamond around each pixel)."""
-    return ndimage.binary_dilation(mask, iterations=pixels)
+    """Grow a mask by ``pixels`` 4-connected steps (a diamond around each pixel).
+
+    OpenCV's dilation by the 3 x 3 cross, which beyond the image's edge sees nothing to grow
+    from: scipy's ``binary_dilation`` with its defaults, at a tenth of the cost on a frame
+    (``pixels=0`` leaves the mask as it is, where scipy would grow it until nothing changes).
+    """
+    if pixels <= 0:
+        return mask.copy()
+    cross = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
+    return cv2.dilate(mask.astype(np.uint8), cross, iterations=pixels).astype(bool)
 
 
 def platform_vfov(params: InspectionParams) -> float:
