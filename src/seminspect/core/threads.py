@@ -1,10 +1,12 @@
-"""Small matrix products on one BLAS thread, and how many threads a mission's sensors use.
+"""The threads of a mission: how many its sensors use, how work is dealt out to them, the
+one-thread workers that run in the background, and small matrix products on one BLAS thread.
 
 Rotating a frame's rays is a ``(N, 3) @ (3, 3)`` product: far too little work per row for
 OpenBLAS to gain from its threads, yet it wakes them for every call, and on a busy machine the
 hand-over alone can cost many times the product (docs/benchmarks.md, "Missions at 50x real
 time"). One thread computes every row with the same kernel, so the result is bit-for-bit the
-multi-threaded one (``tests/core/test_threads.py``).
+multi-threaded one (``tests/core/test_threads.py``); dealt out in blocks to the sensors'
+threads (:func:`run_dealt`), each row is still computed by that kernel.
 """
 
 from __future__ import annotations
