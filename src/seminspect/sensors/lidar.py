@@ -12,6 +12,7 @@ import math
 from dataclasses import dataclass, field
 from functools import cached_property
 
+import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
@@ -108,20 +109,78 @@ class Lidar:
         body, ring = self.rays
         directions = rotate_rows(body, rotation.as_matrix().astype(np.float32))
         distance, face = world.raycaster.cast(origin, directions, self.max_range, threads)
-        hit = face >= 0
-        ranges = distance[hit].astype(np.float64)
-        if noise is not None and noise.lidar_range_noise_m:
-            ranges += require_rng(rng).normal(0.0, noise.lidar_range_noise_m, ranges.shape)
-            ranges = np.maximum(ranges, 0.0)
-        faces = face[hit]
+        returns = int(np.count_nonzero(face >= 0))
+        range_noise = (
+            require_rng(rng).normal(0.0, noise.lidar_range_noise_m, returns)
+            if noise is not None and noise.lidar_range_noise_m
+            else np.empty(0)
+        )
+        points, instance, class_id, part_id, rings, misses = _sort_returns(
+            origin,
+            directions,
+            distance,
+            face,
+            range_noise,
+            returns,
+            world.face_instance,
+            world.face_class,
+            world.face_part,
+            ring,
+        )
         return LidarScan(
-            points=origin + directions[hit] * ranges[:, None],
-            instance=world.face_instance[faces],
-            class_id=world.face_class[faces],
-            part_id=world.face_part[faces],
-            ring=ring[hit],
+            points=points,
+            instance=instance,
+            class_id=class_id,
+            part_id=part_id,
+            ring=rings,
             origin=origin,
             stamp=float(stamp),
-            misses=directions[~hit],
+            misses=misses,
             max_range=self.max_range,
         )
+
+
+@numba.njit(cache=True)
+def _sort_returns(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
+    origin: np.ndarray,
+    directions: np.ndarray,
+    distance: np.ndarray,
+    face: np.ndarray,
+    range_noise: np.ndarray,
+    returns: int,
+    face_instance: np.ndarray,
+    face_class: np.ndarray,
+    face_part: np.ndarray,
+    ring: np.ndarray,
+):
+    """The beams that hit a face (``returns`` of them), in beam order: their points (range plus
+    ``range_noise`` where given, at least 0, along the beam from ``origin``), labels and rings;
+    and the directions of the beams that returned nothing.
+
+    One pass instead of a dozen boolean selections, with the numpy expressions' arithmetic:
+    float64 ranges, ``origin + direction * range`` per coordinate
+    (``tests/sensors/test_lidar.py`` holds them as the reference).
+    """
+    points = np.empty((returns, 3), np.float64)
+    instance = np.empty(returns, face_instance.dtype)
+    class_id = np.empty(returns, face_class.dtype)
+    part_id = np.empty(returns, face_part.dtype)
+    rings = np.empty(returns, ring.dtype)
+    misses = np.empty((face.shape[0] - returns, 3), directions.dtype)
+    noisy = range_noise.shape[0] > 0
+    k = m = 0
+    for beam in range(face.shape[0]):
+        hit = face[beam]
+        if hit < 0:
+            misses[m] = directions[beam]
+            m += 1
+            continue
+        reach = np.float64(distance[beam])
+        if noisy:
+            reach = max(reach + range_noise[k], 0.0)
+        for axis in range(3):
+            points[k, axis] = origin[axis] + np.float64(directions[beam, axis]) * reach
+        instance[k], class_id[k], part_id[k] = face_instance[hit], face_class[hit], face_part[hit]
+        rings[k] = ring[beam]
+        k += 1
+    return points, instance, class_id, part_id, rings, misses
