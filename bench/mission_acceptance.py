@@ -6,8 +6,9 @@ table per run with the paper's columns, the aggregate acceptance figures of issu
 detected >= 95 %, inspected 100 % of detected, localisation RMSE <= 0.25 m, every layer
 populated, no collision) and the paper's own rows beside ours.
 
-The figures do not depend on the machine (simulated time drives the robot; everything is
-seeded); only the wall-clock columns do.
+The figures do not depend on the machine's speed (simulated time drives the robot; everything
+is seeded), but on its kind of CPU (docs/reproduction.md, "Reproducing on another machine");
+the wall-clock columns vary from run to run.
 
 Run: ``.venv/bin/python bench/mission_acceptance.py [--out runs/acceptance] [--json out.json]``
 (``--reuse`` reads completed runs of the same configuration instead of running them again).

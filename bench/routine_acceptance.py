@@ -9,7 +9,7 @@ Runs, on the 20 m mine drift with the paper's parameters (d_view 2 m, γ_H 0.6, 
 
 then times SA-TSP against LKH (elkai) on the tasks' view sets and on view grids of growing
 size. Prints one Markdown table per study and the acceptance checks, and writes every figure
-to a JSON file. Simulated figures do not depend on the machine; the timings do.
+to a JSON file. Simulated figures do not depend on the machine's speed; the timings do.
 
 Run: ``.venv/bin/python bench/routine_acceptance.py [--out runs/routine-acceptance]
 [--json routine-acceptance.json]``

@@ -20,6 +20,7 @@ def test_map_then_inspect_with_the_recorded_prior(capsys, tmp_path):
     )  # fmt: skip
     assert code == 0, err
     assert "tasks 2/2" in out and "collisions 0" in out
+    assert out.startswith("completed: ")  # styled, not printed as markup
     status = read_versioned_json(tmp_path / "run" / "status.json", "seminspect.run-status", [1])
     assert status["state"] == "completed"
     assert (tmp_path / "run" / "performance.png").exists()

@@ -4,10 +4,11 @@ import numpy as np
 import pytest
 
 from seminspect.core.io import read_versioned_json
-from seminspect.mapping.voxel import load_map
-from seminspect.missions.routine import RoutineConfig, _checkpoints
+from seminspect.mapping.voxel import OCCUPIED, VoxelMap, load_map
+from seminspect.missions.routine import RoutineConfig, _checkpoints, leg_slack
 from seminspect.missions.routine_run import PRIOR_FILE, run_routine
 from seminspect.missions.rundir import read_metrics_document
+from seminspect.planning.global_views import pose_is_clear
 
 SMALL = {"scenario": "receding", "seed": 1, "length": 12.0}
 
@@ -121,3 +122,22 @@ def test_pins_the_nominal_row_of_the_reproduction_doc(tmp_path):
     assert m["gamma_s_max"] == pytest.approx(0.23, abs=0.005)
     assert m["viewpoint_utility_mean"] == pytest.approx(0.845, abs=0.0005)
     assert m["roi_coverage_pct"] == pytest.approx(99.2, abs=0.05)
+
+
+def test_a_point_the_planner_calls_clear_passes_the_leg_check_with_its_slack() -> None:
+    resolution, radius = 0.1, 0.6
+    grid = VoxelMap.empty([0.0, 0.0, 0.0], [3.0, 3.0, 2.0], resolution)
+    rng = np.random.default_rng(0)
+    occupied = rng.integers(0, grid.shape, size=(6, 3))
+    grid.states[tuple(occupied.T)] = OCCUPIED
+    obstacles = grid.origin + (occupied + 0.5) * resolution
+    points = rng.uniform([0.0, 0.0, 0.0], [3.0, 3.0, 2.0], size=(3000, 3))
+    # The planner's rule: a cell is clear when its centre is `radius` from every obstacle's.
+    centres = grid.origin + (np.floor((points - grid.origin) / resolution) + 0.5) * resolution
+    distances = np.linalg.norm(centres[:, None] - obstacles[None], axis=2).min(axis=1)
+    planner_clear = points[distances >= radius]
+    assert len(planner_clear) > 500
+    slack = leg_slack(resolution)
+    assert all(pose_is_clear(grid, point, radius - slack) for point in planner_clear)
+    # without the slack the leg check refuses points of cells the planner calls clear
+    assert not all(pose_is_clear(grid, point, radius) for point in planner_clear)

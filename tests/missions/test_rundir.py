@@ -153,6 +153,17 @@ def test_reuse_says_why_a_run_cannot_stand_for_a_new_one(tmp_path) -> None:
     assert not changed and "source changed" in changed.reason and "numpy 0.1 ->" in changed.reason
 
 
+def test_a_run_made_on_another_kind_of_cpu_is_not_reused(tmp_path) -> None:
+    config = resolve(make_config(CONFIG))
+    stored = _stored_run(tmp_path / "r", config)
+    document = json.loads((stored / "config.json").read_text())
+    document["code"]["platform"]["cpu_vendor"] = "OtherVendor"
+    (stored / "config.json").write_text(json.dumps(document))
+    elsewhere = reusable_run(stored, config)
+    assert not elsewhere and "another kind of machine" in elsewhere.reason
+    assert "OtherVendor" in elsewhere.reason
+
+
 def test_the_run_records_the_code_and_libraries(tmp_path) -> None:
     config = resolve(make_config(CONFIG))
     document = json.loads((_stored_run(tmp_path / "r", config) / "config.json").read_text())

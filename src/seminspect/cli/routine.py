@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from seminspect.cli._common import console, err_console, progress_bar
+from seminspect.cli._common import console, err_console, labelled, progress_bar
 
 app = typer.Typer(no_args_is_help=True, help="Routine inspection on an outdated map (002).")
 
@@ -129,7 +129,7 @@ def inspect_command(
 def _print_result(name: str, result) -> None:
     m = result.metrics
     label = f"{name}: " if name else ""
-    console.print(f"[bold]{label}{result.state}[/]: {result.reason}")
+    console.print(labelled(f"{label}{result.state}:", "bold", result.reason))
     if not m:
         return
     console.print(

@@ -387,8 +387,12 @@ def _map_bag(bag: Path, topics: tuple[str, str, str, str | None], out: Path, enc
     cloud.source = {"bag": str(bag), "cloud_topic": cloud_topic, "odom_topic": odom_topic}
     save_cloud(out, cloud)
     console.print(
-        f"[bold]semantic cloud[/] written to {out}: {len(cloud):,} points from {bag}, "
-        f"{cloud.counts.mean():.1f} views per point",
+        labelled(
+            "semantic cloud",
+            "bold",
+            f"written to {out}: {len(cloud):,} points from {bag}, "
+            f"{cloud.counts.mean():.1f} views per point",
+        ),
         highlight=False,
         soft_wrap=True,
     )

@@ -1,18 +1,22 @@
-"""Which code made a result: the package version, a hash of its source, the git revision and
-the versions of the libraries whose behaviour shapes the numbers.
+"""Which code made a result: the package version, a hash of its source, the git revision, the
+versions of the libraries whose behaviour shapes the numbers and the machine's floating-point
+paths.
 
 A run directory records this so a later reader can tell whether a stored run still stands for
-the current code (see ``missions.rundir.reusable_run``).
+the current code on the current machine (see ``missions.rundir.reusable_run``).
 """
 
 from __future__ import annotations
 
 import functools
 import hashlib
+import platform
 import subprocess
 from importlib import metadata
 from pathlib import Path
 from typing import Any
+
+from threadpoolctl import threadpool_info
 
 import seminspect
 
@@ -77,6 +81,56 @@ def dependency_versions() -> dict[str, str | None]:
     return versions
 
 
+#: x86 instruction sets that change floating-point results, widest first (``/proc/cpuinfo``
+#: flag names).
+_SIMD_LEVELS = ("avx512f", "avx2", "avx", "sse4_2")
+
+
+@functools.cache
+def numeric_platform() -> dict[str, str]:
+    """The machine's floating-point paths: what a run's figures depend on beside the code,
+    the library versions and the seed.
+
+    Embree intersects rays with the widest SIMD instruction set the CPU offers, refining the
+    CPU's own reciprocal estimates (which differ between vendors); OpenBLAS picks its kernels
+    by CPU model. Runs of the same code and seed agree bit for bit on machines that agree on
+    every field; elsewhere their distances differ in the last bits, and a mission's path then
+    drifts apart (docs/reproduction.md, "Reproducing on another machine").
+    """
+    import numpy  # noqa: F401, PLC0415 - loads the BLAS that threadpool_info looks for
+
+    vendor, flags = _cpu_identity()
+    simd = next((level for level in _SIMD_LEVELS if level in flags), "none" if flags else "")
+    blas = _numpy_blas_architecture()
+    return {
+        "machine": platform.machine(),
+        "cpu_vendor": vendor or platform.processor(),
+        "simd": simd,
+        "blas_kernels": blas,
+    }
+
+
+def _numpy_blas_architecture() -> str:
+    """The kernels of the BLAS numpy calls: OpenCV ships an OpenBLAS of its own, and which of
+    the two a process loaded first must not change the answer."""
+    blas = [lib for lib in threadpool_info() if lib["user_api"] == "blas"]
+    numpy_first = sorted(blas, key=lambda lib: "numpy" not in Path(lib["filepath"]).parent.name)
+    return str(numpy_first[0].get("architecture", "")) if numpy_first else ""
+
+
+def _cpu_identity() -> tuple[str, set[str]]:
+    """The CPU's vendor and feature flags as Linux reports them (empty elsewhere)."""
+    try:
+        text = Path("/proc/cpuinfo").read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return "", set()
+    fields: dict[str, str] = {}
+    for line in text.splitlines():
+        key, _, value = line.partition(":")
+        fields.setdefault(key.strip(), value.strip())
+    return fields.get("vendor_id", ""), set(fields.get("flags", "").split())
+
+
 def code_version() -> dict[str, Any]:
     """Everything :mod:`seminspect.core.provenance` records, as a JSON-ready dict."""
     return {
@@ -84,6 +138,7 @@ def code_version() -> dict[str, Any]:
         "source_sha256": source_hash(),
         "git": git_revision(),
         "dependencies": dependency_versions(),
+        "platform": numeric_platform(),
     }
 
 
@@ -99,7 +154,18 @@ def code_differences(recorded: dict[str, Any], current: dict[str, Any]) -> list[
     for name in sorted(set(old) | set(new)):
         if old.get(name) != new.get(name):
             differences.append(f"{name} {old.get(name)} -> {new.get(name)}")
+    # Records from before the platform was recorded cannot tell; they are taken at their word.
+    was, now = recorded.get("platform"), current.get("platform")
+    if was and now and was != now:
+        differences.append(f"machine {platform_label(was)} -> {platform_label(now)}")
     return differences
+
+
+def platform_label(fields: dict[str, str]) -> str:
+    """A :func:`numeric_platform` record in a few words, e.g. ``x86_64 GenuineIntel avx512f``."""
+    return " ".join(
+        fields[key] for key in ("machine", "cpu_vendor", "simd", "blas_kernels") if fields.get(key)
+    )
 
 
 def _short(digest: Any) -> str:

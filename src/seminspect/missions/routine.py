@@ -435,12 +435,15 @@ class RoutineMission:
         )
 
     # ----------------------------------------------------------------- motion on M_C
-    def _clear(self, point: NDArray[np.float64]) -> bool:
-        return pose_is_clear(self.current_map, point, self.config.robot_radius + PLANNING_MARGIN_M)
+    def _clear(self, point: NDArray[np.float64], slack: float = 0.0) -> bool:
+        radius = self.config.robot_radius + PLANNING_MARGIN_M - slack
+        return pose_is_clear(self.current_map, point, radius)
 
-    def _segment_clear(self, a: NDArray[np.float64], b: NDArray[np.float64]) -> bool:
+    def _segment_clear(
+        self, a: NDArray[np.float64], b: NDArray[np.float64], slack: float = 0.0
+    ) -> bool:
         steps = max(2, math.ceil(float(np.linalg.norm(b - a)) / self.current_map.resolution))
-        return all(self._clear(a + (b - a) * s) for s in np.linspace(0.0, 1.0, steps)[1:])
+        return all(self._clear(a + (b - a) * s, slack) for s in np.linspace(0.0, 1.0, steps)[1:])
 
     def _go_to(self, goal: NDArray[np.float64], yaw: float | None = None) -> bool:
         """Reach ``goal`` over M_C, sensing every metre and re-planning when the map changes."""
@@ -470,7 +473,7 @@ class RoutineMission:
                 leg = point - here
                 step = min(1.0, SENSE_EVERY_M / max(float(np.linalg.norm(leg)), 1e-9))
                 target = here + leg * step
-                if not self._segment_clear(here, target):
+                if not self._segment_clear(here, target, leg_slack(self.current_map.resolution)):
                     return "replan"
                 heading = yaw if last else math.atan2(leg[1], leg[0])
                 result = self.robot.move_to(target, heading)
@@ -491,6 +494,18 @@ class RoutineMission:
     @property
     def collisions(self) -> int:
         return sum(event["event"] == "collision" for event in self.events)
+
+
+def leg_slack(resolution: float) -> float:
+    """How much closer than the planned clearance a leg of a planned path may pass.
+
+    The planner keeps cell centres its clearance away from occupied cell centres, while
+    :func:`pose_is_clear` samples around a point anywhere in its cell: the two can disagree by
+    a cell diagonal. Re-checking a leg with this slack never refuses a path the planner has
+    just made (which re-planned the same path until ``_go_to`` gave up), yet still catches an
+    obstacle seen on it since.
+    """
+    return math.sqrt(3.0) * resolution
 
 
 def _checkpoints(route: NDArray[np.float64], spacing: float) -> list[NDArray[np.float64]]:

@@ -455,7 +455,7 @@ class Reuse:
 
 def reusable_run(run_dir: Path, config: MissionConfig) -> Reuse:
     """Whether ``run_dir`` holds a completed run of exactly ``config``, with its map, made by the
-    same code and libraries as this process (the reason when not)."""
+    same code and libraries as this process on the same kind of CPU (the reason when not)."""
     try:
         status = read_run_status(run_dir)
         document = read_versioned_json(run_dir / "config.json", CONFIG_FORMAT, [1])
@@ -477,7 +477,11 @@ def _why_not_reusable(
     if "code" not in document:
         return f"{run_dir} does not record the code that made it"
     differences = code_differences(document["code"], code_version())
-    return f"{run_dir} was made by other code: {'; '.join(differences)}" if differences else ""
+    return (
+        f"{run_dir} was made by other code or on another kind of machine: {'; '.join(differences)}"
+        if differences
+        else ""
+    )
 
 
 def _changed_settings(stored: dict[str, Any], wanted: dict[str, Any]) -> list[str]:
