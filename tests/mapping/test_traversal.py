@@ -6,7 +6,12 @@ import math
 import numpy as np
 import pytest
 
-from seminspect.mapping.traversal import FREE, OCCUPIED, integrate_rays_kernel
+from seminspect.mapping.traversal import (
+    FREE,
+    MIN_RAYS_PER_THREAD,
+    OCCUPIED,
+    integrate_rays_kernel,
+)
 
 
 def _reference_clip(o, d, shape) -> tuple[float, float]:
@@ -121,3 +126,19 @@ def test_walks_started_at_their_end_only_set_their_end_cells() -> None:
     )
     assert states[8, 1, 1] == OCCUPIED and states[6, 2, 2] == FREE
     assert np.count_nonzero(states) == 2
+
+
+@pytest.mark.parametrize("threads", [2, 3])
+@pytest.mark.parametrize("shared_origin", [True, False])
+def test_walks_dealt_out_to_threads_give_the_one_thread_map(threads, shared_origin) -> None:
+    rng = np.random.default_rng(threads)
+    grid_origin, resolution = np.array([0.0, 0.0, 0.0]), 0.25
+    before = np.zeros((24, 20, 16), dtype=np.uint8)
+    before[rng.random(before.shape) < 0.02] = OCCUPIED
+    # enough rays to be dealt out; many cross cells other rays end on
+    origins, ends, hit = _random_rays(rng, 4 * MIN_RAYS_PER_THREAD, shared_origin)
+    one, dealt = before.copy(), before.copy()
+    integrate_rays_kernel(one, grid_origin, resolution, origins, ends, hit, np.zeros(0))
+    integrate_rays_kernel(dealt, grid_origin, resolution, origins, ends, hit, np.zeros(0), threads)
+    assert (one == OCCUPIED).sum() > (before == OCCUPIED).sum() + 500
+    np.testing.assert_array_equal(dealt, one)

@@ -5,6 +5,11 @@ Each ray is clipped to the grid, then walked cell by cell: every cell it crosses
 the cell holding its end point becomes occupied if the ray hit a surface there. Occupied cells
 stay occupied (a grazing ray never erases a surface another ray saw), which keeps the map
 conservative for planning.
+
+The walks therefore commute: a cell ends occupied if it was or any ray ends on a surface in it,
+else free if it was or any ray crosses or ends in it. So rays may be walked on several threads
+at once, each only ever turning unknown cells free, with the occupied end cells set after all
+of them: the same map as one thread walking the rays in order.
 """
 
 from __future__ import annotations
@@ -13,6 +18,8 @@ import math
 
 import numba
 import numpy as np
+
+from seminspect.core.threads import run_dealt
 
 UNKNOWN = np.uint8(0)
 FREE = np.uint8(1)
@@ -71,9 +78,10 @@ def _walk(  # noqa: PLR0917 - scalars keep the per-ray walk free of allocations
     dz: float,
     hit: bool,
     t_start: float,
-) -> None:
+) -> int:
     """Free every cell of ``o + t d`` for ``t`` from ``t_start`` (clipped to the grid) to 1;
-    occupy the end cell on a hit.
+    return the flat index of the end cell when the ray ends on a surface there (the caller
+    occupies it), else -1.
 
     ``cells`` is the map's C-ordered states, flattened: the walk moves one index by the
     axis strides instead of indexing in 3D, and writes a cell only when it is still unknown
@@ -86,7 +94,7 @@ def _walk(  # noqa: PLR0917 - scalars keep the per-ray walk free of allocations
     t0, t1 = _clip_axis(t0, t1, oy, dy, ny)
     t0, t1 = _clip_axis(t0, t1, oz, dz, nz)
     if t0 > t1:
-        return
+        return -1
     i, j, k = _cell(ox + t0 * dx, nx), _cell(oy + t0 * dy, ny), _cell(oz + t0 * dz, nz)
     li, lj, lk = _cell(ox + t1 * dx, nx), _cell(oy + t1 * dy, ny), _cell(oz + t1 * dz, nz)
     si, mi, di = _start_axis(ox, dx, i)
@@ -116,12 +124,18 @@ def _walk(  # noqa: PLR0917 - scalars keep the per-ray walk free of allocations
         if not inside:
             break
     # The end cell is set even when rounding let the walk slip past it along an edge or corner.
-    if cells[last] != OCCUPIED:
-        cells[last] = OCCUPIED if occupy_end else FREE
+    if occupy_end:
+        return last
+    if cells[last] == UNKNOWN:
+        cells[last] = FREE
+    return -1
 
 
-@numba.njit(cache=True, nogil=True)
-def integrate_rays_kernel(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
+#: Below this many rays per thread, a second thread costs more than it saves.
+MIN_RAYS_PER_THREAD = 4096
+
+
+def integrate_rays_kernel(  # noqa: PLR0917 - the compiled kernel's arrays, passed through
     states: np.ndarray,
     grid_origin: np.ndarray,
     resolution: float,
@@ -129,22 +143,55 @@ def integrate_rays_kernel(  # noqa: PLR0917 - a compiled kernel takes its arrays
     ends: np.ndarray,
     hit: np.ndarray,
     carve_from: np.ndarray,
+    threads: int = 1,
 ) -> None:
     """Walk every ray ``origins[r or 0] -> ends[r]`` (world metres) through ``states``.
 
     ``carve_from[r]`` in ``[0, 1]`` is the fraction of ray ``r`` before which it frees nothing
-    (see ``mapping.carving``); an empty array frees every ray from its origin.
+    (see ``mapping.carving``); an empty array frees every ray from its origin. With ``threads``
+    > 1 blocks of rays are dealt out to that many threads and the hits occupied after every
+    walk (the module's docstring says why the map is the same).
     """
+    arrays = (states, grid_origin, resolution, origins, ends, hit, carve_from)
+    count = ends.shape[0]
+    if threads <= 1 or count < 2 * MIN_RAYS_PER_THREAD:
+        _walk_rays(*arrays, 0, count, np.empty(0, dtype=np.int64))
+        return
+    occupy = np.empty(count, dtype=np.int64)
+
+    def walk(block: slice) -> None:
+        _walk_rays(*arrays, block.start, block.stop, occupy)
+
+    run_dealt(walk, count, threads, MIN_RAYS_PER_THREAD)
+    _occupy(states, occupy)
+
+
+@numba.njit(cache=True, nogil=True)
+def _walk_rays(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
+    states: np.ndarray,
+    grid_origin: np.ndarray,
+    resolution: float,
+    origins: np.ndarray,
+    ends: np.ndarray,
+    hit: np.ndarray,
+    carve_from: np.ndarray,
+    first: int,
+    stop: int,
+    occupy: np.ndarray,
+) -> None:
+    """Walk rays ``first`` to ``stop - 1``; occupy their hits at once, or, given an ``occupy``
+    array for every ray, write each ray's cell to occupy there (-1: none) for later."""
     thinned = carve_from.shape[0] > 0
+    deferred = occupy.shape[0] > 0
     cells = states.reshape(-1)
     shape = states.shape
     shared = origins.shape[0] == 1
-    for r in range(ends.shape[0]):
+    for r in range(first, stop):
         src = origins[0] if shared else origins[r]
         ox = (src[0] - grid_origin[0]) / resolution
         oy = (src[1] - grid_origin[1]) / resolution
         oz = (src[2] - grid_origin[2]) / resolution
-        _walk(
+        end = _walk(
             cells,
             shape,
             ox,
@@ -156,3 +203,16 @@ def integrate_rays_kernel(  # noqa: PLR0917 - a compiled kernel takes its arrays
             hit[r],
             carve_from[r] if thinned else 0.0,
         )
+        if deferred:
+            occupy[r] = end
+        elif end >= 0:
+            cells[end] = OCCUPIED
+
+
+@numba.njit(cache=True, nogil=True)
+def _occupy(states: np.ndarray, occupy: np.ndarray) -> None:
+    """Occupy the end cells of the rays that hit (``occupy[r] >= 0``)."""
+    cells = states.reshape(-1)
+    for index in occupy:
+        if index >= 0:
+            cells[index] = OCCUPIED

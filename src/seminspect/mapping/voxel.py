@@ -25,7 +25,7 @@ from scipy.spatial.transform import Rotation
 
 from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.core.io import save_npz_atomic
-from seminspect.core.threads import rotate_rows, serial_worker
+from seminspect.core.threads import rotate_rows, sensor_threads, serial_worker
 from seminspect.geometry.raster import cells_touching_triangles
 from seminspect.geometry.transforms import as_point, as_points
 from seminspect.mapping import carving
@@ -57,7 +57,9 @@ class VoxelMap:
             replacing :attr:`states` first waits for every walk handed over, and the walks run
             in the order they were handed over, so every read sees the cells the same
             integrations would have left in place. An array taken from :attr:`states` is the
-            live grid: read it before integrating more, not across an integration.
+            live grid: read it before integrating more, not across an integration. Without it
+            the caller's large batches are walked on the sensors' threads
+            (:func:`~seminspect.core.threads.sensor_threads`; the same map on any number).
     """
 
     def __init__(self, origin: ArrayLike, resolution: float, states: NDArray[np.uint8]) -> None:
@@ -249,7 +251,14 @@ class VoxelMap:
             self._pending.append(walks)
         else:
             integrate_rays_kernel(
-                self.states, self.origin, self.resolution, start, ends, flags, starts
+                self.states,
+                self.origin,
+                self.resolution,
+                start,
+                ends,
+                flags,
+                starts,
+                sensor_threads(),
             )
 
     def integrate_frame(
