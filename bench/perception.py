@@ -70,7 +70,7 @@ def vehicle_frames(world: World, views: int) -> list[Frame]:
 def whole_frame_detect(frame: Frame, world: World, level: str, noise, rng) -> list[int]:
     """``detect``'s steps on whole-frame masks (the form before masks were cut to their box);
     the areas of the masks it keeps."""
-    key, candidates = _keys(frame, world, level, VEHICLES, None)
+    key, candidates, _ = _keys(frame, world, level, VEHICLES, None)
     background = frame.instance == 0
     areas = []
     for value, _label, _inst in candidates:

@@ -10,7 +10,7 @@ from seminspect.core.rng import make_rng
 from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.sensors import CameraModel, detect, detect_instances, detect_parts, render
 from seminspect.sensors.noise import NoiseModel, make_noise
-from seminspect.sensors.segmentation import distinct_positive
+from seminspect.sensors.segmentation import key_boxes
 from seminspect.worlds import WorldBuilder
 from seminspect.worlds.shapes import pose_matrix
 from seminspect.worlds.vehicles import vehicle_pieces
@@ -133,13 +133,17 @@ def test_noisy_detection_is_seeded(scene) -> None:
     assert math.isinf(detect(frame, world, "instance")[0].depth_m) is False
 
 
-def test_distinct_positive_matches_numpy_unique() -> None:
+def test_key_boxes_match_numpy_unique_and_each_values_extent() -> None:
     rng = np.random.default_rng(5)
     small = rng.integers(-3, 40, (48, 64))
-    large = np.append(rng.integers(0, 5, 20), 10**9)  # beyond a counting table: sorted instead
-    for values in (small, large, np.zeros((4, 4), dtype=np.int64)):
-        expected = np.unique(values[values > 0])
-        np.testing.assert_array_equal(distinct_positive(values), expected)
+    large = np.append(rng.integers(0, 5, 19), 10**9).reshape(4, 5)  # beyond a table: sorted
+    instances = rng.integers(0, 6, (30, 20)).astype(np.int32)  # a frame's own dtype
+    for key in (small, large, instances, np.zeros((4, 4), dtype=np.int64)):
+        values, boxes = key_boxes(key)
+        np.testing.assert_array_equal(values, np.unique(key[key > 0]))
+        for value, box in zip(values, boxes, strict=True):
+            rows, cols = np.nonzero(key == value)
+            assert box.tolist() == [rows.min(), cols.min(), rows.max() + 1, cols.max() + 1]
 
 
 def _random_labels(scene, seed: int):
