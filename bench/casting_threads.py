@@ -1,11 +1,12 @@
-"""Casting a camera frame on two threads: contiguous halves against blocks dealt out in turn.
+"""Casting a camera frame on two threads: contiguous halves against blocks dealt out.
 
 A frame's top rows (sky, far walls) cast in about half the time of its bottom rows, so when
 each of two threads takes one contiguous half, one waits for the other;
-``core.threads.run_dealt`` deals eight blocks per thread in turn instead. For street poses of
-a city (only the world's own Embree scene in the process, as in a mission) this prints, per
-pose, the best of ``--repeats`` times of: the top and the bottom half alone, the whole frame on
-one thread, in two halves on two threads, and dealt out on two threads.
+``core.threads.run_dealt`` cuts the frame into eight blocks per thread, which the threads take
+one at a time as each comes free. For street poses of a city (only the world's own Embree scene
+in the process, as in a mission) this prints, per pose, the best of ``--repeats`` times of: the
+top and the bottom half alone, the whole frame on one thread, in two halves on two threads, and
+dealt out on two threads.
 
 Run: ``PYTHONPATH=src:bench .venv/bin/python bench/casting_threads.py [--poses 4]``
 """

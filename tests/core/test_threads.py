@@ -9,7 +9,7 @@ from seminspect.core.errors import InvalidInputError
 from seminspect.core.threads import (
     MAX_SENSOR_THREADS,
     THREADS_ENV,
-    deal_range,
+    blocks_of,
     rotate_rows,
     run_dealt,
     sensor_threads,
@@ -75,32 +75,45 @@ def test_an_unusable_thread_count_is_refused_in_one_line(monkeypatch, setting):
         sensor_threads()
 
 
-def test_deal_range_covers_the_range_once_in_blocks_dealt_in_turn():
-    hands = deal_range(10_000, 3, 1000, blocks_per_thread=4)
-    assert len(hands) == 3 and all(len(hand) == 4 for hand in hands)
-    blocks = sorted((block for hand in hands for block in hand), key=lambda b: b.start)
+def test_blocks_of_cover_the_range_once_in_nearly_equal_blocks():
+    blocks = blocks_of(10_000, 3, 1000, blocks_per_thread=4)
+    assert len(blocks) == 12
     assert [b.start for b in blocks] == [0, *(b.stop for b in blocks[:-1])]
     assert blocks[-1].stop == 10_000
     assert max(b.stop - b.start for b in blocks) - min(b.stop - b.start for b in blocks) <= 1
-    # Dealt in turn: a thread's blocks are every third one, so each gets a share of every region.
-    assert [b.start for b in hands[1]] == [b.start for b in blocks[1::3]]
 
 
-def test_deal_range_keeps_small_or_single_threaded_work_whole():
-    assert deal_range(1999, 2, 1000) == [[slice(0, 1999)]]  # under two threads' worth
-    assert deal_range(10_000, 1, 1000) == [[slice(0, 10_000)]]
+def test_blocks_of_keep_small_or_single_threaded_work_whole():
+    assert blocks_of(1999, 2, 1000) == [slice(0, 1999)]  # under two threads' worth
+    assert blocks_of(10_000, 1, 1000) == [slice(0, 10_000)]
 
 
 @pytest.mark.parametrize("threads", [1, 2, 3])
-def test_run_dealt_does_every_item_once_the_caller_its_own_hand(threads):
+def test_run_dealt_does_every_item_once(threads):
     done = np.zeros(50_000, dtype=np.int64)
-    workers: dict[int, int] = {}
 
     def work(block: slice) -> None:
-        workers[block.start] = threading.get_ident()
         done[block] += 1
 
     run_dealt(work, len(done), threads, 1000)
     assert np.all(done == 1)
-    mine = {start for start, worker in workers.items() if worker == threading.get_ident()}
-    assert mine == {block.start for block in deal_range(len(done), threads, 1000)[0]}
+
+
+def test_a_thread_held_up_takes_fewer_blocks():
+    """The caller's first block stalls; the pool worker takes every other block."""
+    caller = threading.get_ident()
+    taken: dict[int, int] = {}
+    held: list[int] = []
+    release = threading.Event()
+
+    def work(block: slice) -> None:
+        taken[block.start] = threading.get_ident()
+        if threading.get_ident() == caller and not held:
+            held.append(block.start)
+            release.wait(timeout=5)  # until the other thread has done the rest
+        elif len(taken) == 16:
+            release.set()
+
+    run_dealt(work, 16_000, 2, 1000)
+    assert len(taken) == 16
+    assert [start for start, thread in taken.items() if thread == caller] == held

@@ -106,42 +106,47 @@ def serial_worker(purpose: str) -> ThreadPoolExecutor:
     return ThreadPoolExecutor(1, thread_name_prefix=f"seminspect-{purpose}")
 
 
-#: Blocks per thread when a batch is dealt out: enough that each thread gets a share of every
-#: part of an image or a scan, few enough that a block's call overhead stays negligible.
+#: Blocks per thread when a batch is dealt out: enough that the threads end together, few
+#: enough that a block's call overhead stays negligible.
 BLOCKS_PER_THREAD = 8
 
 
-def deal_range(
+def blocks_of(
     count: int, threads: int, min_per_thread: int, blocks_per_thread: int = BLOCKS_PER_THREAD
-) -> list[list[slice]]:
-    """``range(count)`` cut into contiguous blocks dealt out in turn, one hand per thread; one
-    hand of one block when a thread would get fewer than ``min_per_thread`` items (below that,
-    splitting costs more than it saves).
-
-    Dealing rather than halving balances the threads: a camera's top rows see sky and far walls
-    and cast much faster than its bottom rows, and a LiDAR's rings differ the same way, so
-    contiguous halves left one thread waiting for the other (docs/benchmarks.md).
-    """
+) -> list[slice]:
+    """``range(count)`` cut into ``threads * blocks_per_thread`` contiguous blocks of nearly
+    equal size, in order; one block when a thread would get fewer than ``min_per_thread`` items
+    (below that, splitting costs more than it saves)."""
     if threads <= 1 or count < 2 * min_per_thread:
-        return [[slice(0, count)]]
+        return [slice(0, count)]
     bounds = np.linspace(0, count, threads * blocks_per_thread + 1).astype(int)
-    blocks = [slice(int(a), int(b)) for a, b in itertools.pairwise(bounds)]
-    return [blocks[thread::threads] for thread in range(threads)]
+    return [slice(int(a), int(b)) for a, b in itertools.pairwise(bounds)]
 
 
 def run_dealt(
     work: Callable[[slice], object], count: int, threads: int, min_per_thread: int
 ) -> None:
-    """Call ``work`` on every block of :func:`deal_range`: the calling thread works through the
-    first hand while the pool works through the others. For work whose result does not depend
-    on the split (each item on its own) and that releases the GIL."""
-    hands = deal_range(count, threads, min_per_thread)
+    """Call ``work`` on every block of :func:`blocks_of`, the calling thread and ``threads - 1``
+    pool workers each taking the next block not yet taken until none is left. For work whose
+    result does not depend on the split (each item on its own) and that releases the GIL.
 
-    def work_through(hand: list[slice]) -> None:
-        for block in hand:
-            work(block)
+    Taking blocks as each thread comes free balances the threads however the work is spread: a
+    camera's top rows (sky, far walls) cast in about half the time of its bottom rows, and a
+    LiDAR's rings differ the same way; and a thread the system pauses for a while (the map's
+    walks and the noise drawn ahead share the cores) or a pool worker slow to wake simply
+    takes fewer blocks (docs/benchmarks.md).
+    """
+    blocks = blocks_of(count, threads, min_per_thread)
+    if len(blocks) == 1:
+        work(blocks[0])
+        return
+    claim = itertools.count()  # next() on it is atomic under the GIL
 
-    others = [thread_pool(threads).submit(work_through, hand) for hand in hands[1:]]
-    work_through(hands[0])
+    def work_through() -> None:
+        while (taken := next(claim)) < len(blocks):
+            work(blocks[taken])
+
+    others = [thread_pool(threads).submit(work_through) for _ in range(threads - 1)]
+    work_through()
     for other in others:
         other.result()
