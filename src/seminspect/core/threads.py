@@ -149,4 +149,6 @@ def run_dealt(
     others = [thread_pool(threads).submit(work_through) for _ in range(threads - 1)]
     work_through()
     for other in others:
-        other.result()
+        # A worker that has not started would find nothing left: it is not waited for.
+        if not other.cancel():
+            other.result()

@@ -57,8 +57,8 @@ class VoxelMap:
             replacing :attr:`states` first waits for every walk handed over, and the walks run
             in the order they were handed over, so every read sees the cells the same
             integrations would have left in place. An array taken from :attr:`states` is the
-            live grid: read it before integrating more, not across an integration. Without it
-            the caller's large batches are walked on the sensors' threads
+            live grid: read it before integrating more, not across an integration. Either
+            way a large batch of rays is dealt out to the sensors' threads
             (:func:`~seminspect.core.threads.sensor_threads`; the same map on any number).
     """
 
@@ -247,6 +247,7 @@ class VoxelMap:
                 ends.copy(),
                 flags.copy(),
                 starts.copy(),
+                sensor_threads(),
             )
             self._pending.append(walks)
         else:
