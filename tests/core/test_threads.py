@@ -1,5 +1,6 @@
 import os
 import threading
+import time
 
 import numpy as np
 import pytest
@@ -117,3 +118,23 @@ def test_a_thread_held_up_takes_fewer_blocks():
     run_dealt(work, 16_000, 2, 1000)
     assert len(taken) == 16
     assert [start for start, thread in taken.items() if thread == caller] == held
+
+
+def test_a_failing_block_fails_the_batch_after_the_other_thread_stopped():
+    running = threading.Event()
+    finished = []
+
+    def work(block: slice) -> None:
+        if threading.get_ident() != caller:
+            running.set()
+            time.sleep(0.05)
+            finished.append(block.start)
+        elif running.wait(timeout=5):
+            raise RuntimeError("bad block")
+
+    caller = threading.get_ident()
+    with pytest.raises(RuntimeError, match="bad block"):
+        run_dealt(work, 16_000, 2, 1000)
+    done = len(finished)
+    time.sleep(0.2)
+    assert done >= 1 and len(finished) == done  # nothing ran on after the batch failed

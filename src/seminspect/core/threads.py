@@ -147,8 +147,11 @@ def run_dealt(
             work(blocks[taken])
 
     others = [thread_pool(threads).submit(work_through) for _ in range(threads - 1)]
-    work_through()
-    for other in others:
-        # A worker that has not started would find nothing left: it is not waited for.
-        if not other.cancel():
-            other.result()
+    try:
+        work_through()
+    finally:
+        # Nothing may still write into the caller's arrays once this returns or raises; a
+        # worker that has not started would find nothing left, so it is not waited for.
+        for other in others:
+            if not other.cancel():
+                other.result()
