@@ -28,6 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.ndimage import distance_transform_edt
 
 from seminspect.core.errors import InvalidInputError, PlanningError
+from seminspect.core.threads import run_dealt, sensor_threads
 from seminspect.geometry.transforms import as_point
 from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap
 
@@ -104,19 +105,32 @@ def planar_states(voxel_map: VoxelMap, band: tuple[float, float]) -> NDArray[np.
         raise InvalidInputError(
             f"height band [{z_low}, {z_high}] m misses the map, which spans z {z0:g}..{top:g} m"
         )
+    states = voxel_map.states
     layer = np.empty((*voxel_map.shape[:2], 1), dtype=np.uint8)
-    _project_band(voxel_map.states, k_low, k_high, layer)
+
+    def project(rows: slice) -> None:
+        _project_band(states, k_low, k_high, layer, rows.start, rows.stop)
+
+    # Columns project independently: rows of the map are dealt out to the sensors' threads.
+    run_dealt(project, states.shape[0], sensor_threads(), MIN_ROWS_PER_THREAD)
     return layer
 
 
-@numba.njit(cache=True)
-def _project_band(states: np.ndarray, k_low: int, k_high: int, layer: np.ndarray) -> None:
-    """Per column: OCCUPIED if any band cell is, else UNKNOWN if any is, else FREE.
+#: Below this many map rows (of a few hundred columns each) per thread, one thread projects.
+MIN_ROWS_PER_THREAD = 64
+
+
+@numba.njit(cache=True, nogil=True)
+def _project_band(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
+    states: np.ndarray, k_low: int, k_high: int, layer: np.ndarray, first: int, stop: int
+) -> None:
+    """Per column of rows ``first`` to ``stop - 1``: OCCUPIED if any band cell is, else UNKNOWN
+    if any is, else FREE.
 
     One pass that stops at a column's first occupied cell, instead of two whole-band
     comparisons and their temporaries (the map is projected at every local plan).
     """
-    for i in range(states.shape[0]):
+    for i in range(first, stop):
         for j in range(states.shape[1]):
             value = FREE
             for k in range(k_low, k_high):
