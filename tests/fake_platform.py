@@ -86,7 +86,7 @@ class FakePlatform:
     def wait(self, seconds: float) -> None:
         self._time += seconds
 
-    def capture(self) -> Frame:
+    def capture(self, intensity: bool = True) -> Frame:
         self.frames += 1
         self._time += 0.3
         shape = (CAMERA.height, CAMERA.width)
@@ -96,7 +96,7 @@ class FakePlatform:
             instance=np.zeros(shape, np.int32),
             class_id=np.zeros(shape, np.int16),
             part_id=np.zeros(shape, np.int16),
-            intensity=self.image(self._position, self._yaw),
+            intensity=self.image(self._position, self._yaw) if intensity else None,
             face=np.full(shape, -1, np.int32),
             position=self._position.copy(),
             orientation=quat,
@@ -126,8 +126,8 @@ def car_in_view(platform: FakePlatform, distance: float = 4.0) -> None:
     mask = np.zeros((CAMERA.height, CAMERA.width), bool)
     mask[100:160, 120:200] = True
 
-    def capture_with_depth(original=platform.capture):
-        frame = original()
+    def capture_with_depth(intensity: bool = True, original=platform.capture):
+        frame = original(intensity=intensity)
         frame.depth[mask] = distance
         return frame
 

@@ -236,3 +236,21 @@ def test_noise_drawn_ahead_gives_the_same_frames(wall) -> None:
         ahead = render(wall, CameraModel(), *pose, noise=noise, rng=stream)
         np.testing.assert_array_equal(ahead.depth, drawn.depth)
         np.testing.assert_array_equal(ahead.intensity, drawn.intensity)
+
+
+def test_a_frame_without_intensity_keeps_the_depth_labels_and_noise_of_one_with_it(wall) -> None:
+    noise = noise_preset("realistic")
+    poses = [((0.0, y, 1.5), quat_from_yaw(0.2 * y)) for y in (0.0, 1.0, 2.0)]
+    shaded, unshaded = make_rng(3, "camera"), make_rng(3, "camera")
+    for k, pose in enumerate(poses):
+        full = render(wall, CameraModel(), *pose, noise=noise, rng=shaded)
+        # every other frame without its intensity: the next frames' noise must not move
+        lean = render(wall, CameraModel(), *pose, noise=noise, rng=unshaded, intensity=k != 1)
+        for name in ("depth", "instance", "class_id", "part_id", "face"):
+            np.testing.assert_array_equal(getattr(lean, name), getattr(full, name))
+        if k == 1:
+            assert lean.intensity is None
+            with pytest.raises(InvalidInputError, match="without its intensity"):
+                lean.grey()
+        else:
+            np.testing.assert_array_equal(lean.grey(), full.intensity)

@@ -214,7 +214,7 @@ class Navigator:
             if self._since_camera >= self.camera_every_m:
                 self._since_camera = 0.0
                 with self.timers("sensing"):
-                    frame = self.platform.capture()
+                    frame = self.platform.capture(intensity=False)
                 self.on_frame(frame)
             if motion.blocked:
                 self.stats.blocked += 1

@@ -87,7 +87,10 @@ class Platform(Protocol):
 
     def wait(self, seconds: float) -> None: ...
 
-    def capture(self) -> Frame: ...
+    def capture(self, intensity: bool = True) -> Frame:
+        """A camera frame; ``intensity=False`` for a caller that reads only depth and labels
+        (``Frame.intensity`` then None; a simulator may skip shading it)."""
+        ...
 
     def detect(self, frame: Frame, level: str, labels: Iterable[str]) -> list[Detection]: ...
 
@@ -221,8 +224,8 @@ class SimulatedPlatform:
         self.robot.wait(seconds)
 
     # ----------------------------------------------------------------- sensing
-    def capture(self) -> Frame:
-        """Stop, then take one 640x480 depth + segmentation + intensity frame."""
+    def capture(self, intensity: bool = True) -> Frame:
+        """Stop, then take one 640x480 depth + segmentation (+ intensity) frame."""
         if self.settle_s:
             self.robot.wait(self.settle_s)
         late, now = self.robot.sensor_poses(self.noise.image_time_offset_s)
@@ -236,6 +239,7 @@ class SimulatedPlatform:
             stamp=now.time,
             odometry=(now.odometry_position, self._camera_quaternion(now.odometry_yaw)),
             threads=self.threads,
+            intensity=intensity,
         )
         self.robot.wait(self.capture_s)
         self.frames += 1

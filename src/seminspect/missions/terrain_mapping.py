@@ -171,7 +171,7 @@ def frame_segments(frame: Frame, world: World) -> tuple[NDArray[np.int64], list[
     ids = np.full(frame.shape, -1, dtype=np.int64)
     ids[valid] = inverse
     segment_class = frame.class_id[valid][first]
-    rgb = np.repeat(frame.intensity[..., None], 3, axis=2)
+    rgb = np.repeat(frame.grey()[..., None], 3, axis=2)
     boxes = ndimage.find_objects(ids + 1, max_label=len(keys))
     segments = [
         Segment(label=world.class_names[int(c)], image=rgb[box])

@@ -114,7 +114,8 @@ class Frame:
         instance: ``int32`` instance id per pixel (0: ground, background or nothing).
         class_id: ``int16`` index into ``World.class_names`` (0 where nothing was hit).
         part_id: ``int16`` index into ``World.part_names`` (0: no part).
-        intensity: ``uint8`` grey image with a stable surface texture.
+        intensity: ``uint8`` grey image with a stable surface texture; None for a frame
+            rendered without it (``render(..., intensity=False)``: see :meth:`grey`).
         face: ``int32`` index of the mesh face seen by each pixel (-1: none).
         position, orientation: the true camera pose the frame was rendered from.
         stamp: time the frame is tagged with (seconds).
@@ -127,7 +128,7 @@ class Frame:
     instance: NDArray[np.int32]
     class_id: NDArray[np.int16]
     part_id: NDArray[np.int16]
-    intensity: NDArray[np.uint8]
+    intensity: NDArray[np.uint8] | None
     face: NDArray[np.int32]
     position: Vec3
     orientation: Quat
@@ -145,6 +146,14 @@ class Frame:
     @property
     def shape(self) -> tuple[int, int]:
         return self.depth.shape  # type: ignore[return-value]
+
+    def grey(self) -> NDArray[np.uint8]:
+        """The intensity image; a clear error for a frame rendered without one."""
+        if self.intensity is None:
+            raise InvalidInputError(
+                "this frame was rendered without its intensity image (render(..., intensity=False))"
+            )
+        return self.intensity
 
     def points(self, mask: ArrayLike | None = None, use_odometry: bool = False) -> NDArray:
         """World points ``(N, 3)`` of the pixels in ``mask`` that saw a surface (row-major).
@@ -219,6 +228,7 @@ def render(
     stride: int = 1,
     odometry: tuple[ArrayLike, ArrayLike] | None = None,
     threads: int = 1,
+    intensity: bool = True,
 ) -> Frame:
     """Render a frame of ``world`` from the camera pose ``(position, orientation [x,y,z,w])``.
 
@@ -230,6 +240,9 @@ def render(
         stride: render every ``stride``-th pixel (see :meth:`CameraModel.scaled`).
         odometry: the ``(position, orientation)`` the robot believed it had at ``stamp``.
         threads: cast the rays on this many threads (the same frame on any number).
+        intensity: shade the intensity image; False leaves it out (``Frame.intensity`` None)
+            for a caller that reads only depth and labels. The noise draws the same deviates
+            either way, so a seeded run's depth noise does not depend on it.
     """
     origin = as_point(position, "camera position")
     quat = as_quaternion(orientation, "camera orientation")
@@ -250,7 +263,7 @@ def render(
     instance = np.empty(count, dtype=np.int32)
     class_id = np.empty(count, dtype=np.int16)
     part_id = np.empty(count, dtype=np.int16)
-    intensity = np.empty(count, dtype=np.uint8)
+    grey = np.empty(count if intensity else 0, dtype=np.uint8)
     albedo, axes, seed, sun = surface_tables(world)
 
     def shade(part: slice) -> None:
@@ -274,7 +287,7 @@ def render(
             instance[part],
             class_id[part],
             part_id[part],
-            intensity[part],
+            grey[part] if intensity else grey,
         )
 
     # Pixels shade independently, so they may be dealt out over threads.
@@ -285,7 +298,7 @@ def render(
         instance=instance.reshape(shape),
         class_id=class_id.reshape(shape),
         part_id=part_id.reshape(shape),
-        intensity=intensity.reshape(shape),
+        intensity=grey.reshape(shape) if intensity else None,
         face=face.reshape(shape),
         position=origin,
         orientation=quat,
@@ -333,15 +346,17 @@ def _add_image_noise(
     All the normal deviates come from one draw: the hit pixels' depth noise first (row-major),
     then one per intensity pixel, the same numbers in the same order as two separate draws.
     ``noise.image_noise_float32`` draws them in single precision (a faster draw, and other
-    numbers).
+    numbers). A frame without its intensity image draws the intensity's deviates all the same
+    and leaves them unused, so the next frame's noise is the same either way.
     """
     depth = frame.depth.reshape(-1)  # views: render's images are contiguous
     noisy_depth = bool(noise.depth_noise_m or noise.depth_noise_per_m)
     hits = int(np.count_nonzero(np.isfinite(depth))) if noisy_depth else 0
-    pixels = frame.intensity.size if noise.intensity_noise else 0
+    pixels = depth.size if noise.intensity_noise else 0
+    grey = np.empty(0, np.uint8) if frame.intensity is None else frame.intensity.reshape(-1)
     _apply_image_noise(
         depth,
-        frame.intensity.reshape(-1),
+        grey,
         rng.standard_normal(hits + pixels, dtype=_DRAW_DTYPE[noise.image_noise_float32]),
         hits > 0,
         np.float32(noise.depth_noise_m),

@@ -67,11 +67,13 @@ def shade_hits(  # noqa: PLR0917 - a compiled kernel takes its arrays positional
     part_id: np.ndarray,
     intensity: np.ndarray,
 ) -> None:
-    """Fill the per-pixel outputs (flat arrays) from ray distances and face indices.
+    """Fill the per-pixel outputs (flat arrays) from ray distances and face indices; an empty
+    ``intensity`` leaves the intensity out (the texture is most of the work).
 
     Neighbouring pixels mostly see the same texture cell, so each octave keeps its last cell
     and value and hashes only when the cell changes (the same values, fewer hashes).
     """
+    grey = intensity.shape[0] > 0
     last_ix = np.zeros(octaves.shape[0], dtype=np.int64)
     last_iy = np.zeros(octaves.shape[0], dtype=np.int64)
     last_seed = np.full(octaves.shape[0], -1, dtype=np.int64)  # seeds are >= 0: no match
@@ -83,13 +85,16 @@ def shade_hits(  # noqa: PLR0917 - a compiled kernel takes its arrays positional
             instance[i] = 0
             class_id[i] = 0
             part_id[i] = 0
-            intensity[i] = SKY_INTENSITY
+            if grey:
+                intensity[i] = SKY_INTENSITY
             continue
         t = distance[i]
         depth[i] = t * axis_cosine[i]
         instance[i] = face_instance[f]
         class_id[i] = face_class[f]
         part_id[i] = face_part[f]
+        if not grey:
+            continue
         a = plane_axes[f, 0]
         b = plane_axes[f, 1]
         u = origin[a] + t * directions[i, a]

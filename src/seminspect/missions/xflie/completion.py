@@ -57,7 +57,7 @@ class LevelCompletion:
         ctx = self.ctx
         params = ctx.params
         with ctx.timers("perception"):
-            features = self.matcher.features(frame.intensity)
+            features = self.matcher.features(frame.grey())
         distance = float(np.linalg.norm(ctx.platform.position - state.start))
         state.left_start |= distance > params.d_thresh_I
         self._track_sweep(state, centre)

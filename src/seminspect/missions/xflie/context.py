@@ -60,10 +60,11 @@ class MissionContext:
     def event(self, kind: str, **fields: object) -> None:
         self.recorder.event(kind, **fields)
 
-    def capture(self) -> Frame:
-        """A camera frame, integrated into the robot's map."""
+    def capture(self, intensity: bool = False) -> Frame:
+        """A camera frame, integrated into the robot's map; with its intensity image only when
+        asked (an inspection view's pictures and features)."""
         with self.timers("sensing"):
-            frame = self.platform.capture()
+            frame = self.platform.capture(intensity=intensity)
         self.integrate(frame)
         return frame
 

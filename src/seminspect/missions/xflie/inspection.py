@@ -96,7 +96,7 @@ class LevelInspection:
         state = LevelState(ctx.platform.position.copy())
         surface = np.empty((0, 3))
         while ctx.time_left > 0:
-            frame = ctx.capture()
+            frame = ctx.capture(intensity=True)
             mask, points = target_view(ctx, frame, target)
             if len(points):
                 heights.append(float(points[:, 2].max()))
@@ -125,7 +125,7 @@ class LevelInspection:
         ctx = self.ctx
         image = None
         if ctx.run is not None and ctx.config.inspection.save_images:
-            image = ctx.run.write_image(f"{target.id}-{ctx.frames_seen:05d}", frame.intensity)
+            image = ctx.run.write_image(f"{target.id}-{ctx.frames_seen:05d}", frame.grey())
         with ctx.timers("graph"):
             ctx.graph.register_pose(ctx.view_pose(image))
         ctx.recorder.coverage.add_frame(target.id, frame, points)
