@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 import os
 from concurrent.futures import Future
-from functools import lru_cache
+from functools import lru_cache, partial
 from pathlib import Path
 
 import numpy as np
@@ -237,30 +237,13 @@ class VoxelMap:
             raise InvalidInputError(f"{starts.size} carving starts for {len(ends)} rays")
         if not len(ends):
             return
+        walk = partial(integrate_rays_kernel, self._cells, self.origin, self.resolution)
         if self.background:  # copies: the caller may reuse its arrays once this returns
-            walks = serial_worker("map").submit(
-                integrate_rays_kernel,
-                self._cells,
-                self.origin,
-                self.resolution,
-                start.copy(),
-                ends.copy(),
-                flags.copy(),
-                starts.copy(),
-                sensor_threads(),
-            )
-            self._pending.append(walks)
+            arrays = (start.copy(), ends.copy(), flags.copy(), starts.copy())
+            self._pending.append(serial_worker("map").submit(walk, *arrays, sensor_threads()))
         else:
-            integrate_rays_kernel(
-                self.states,
-                self.origin,
-                self.resolution,
-                start,
-                ends,
-                flags,
-                starts,
-                sensor_threads(),
-            )
+            self.settle()  # walks handed over before ``background`` was turned off go first
+            walk(start, ends, flags, starts, sensor_threads())
 
     def integrate_frame(
         self,
