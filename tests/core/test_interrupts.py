@@ -41,3 +41,33 @@ def test_a_signal_while_numba_compiles_is_raised_once_compilation_ends():
             time.sleep(0.01)
     assert reached == ["end of compilation"]
     assert stopped.value.signum == signal.SIGTERM
+
+
+def test_a_signal_while_a_kernel_calls_back_into_numba_is_raised_when_it_returns():
+    """Boxing a kernel's tuple of arrays runs numba's Python code, which drops an exception
+    raised there (the call then fails with ``SystemError``); the stop must wait for our code."""
+    import sys
+    import threading
+    import time
+
+    import numba
+    import numpy as np
+
+    @numba.njit
+    def ramp(n):
+        values = np.empty(n)
+        for i in range(n):
+            values[i] = i * 0.5
+        return values, values[::2]
+
+    ramp(3)
+    for _ in range(10):  # raising at once failed nearly every time
+        kill = threading.Timer(0.003, os.kill, (os.getpid(), signal.SIGTERM))
+        with stop_on_signals(), pytest.raises(Interrupted) as stopped:
+            kill.start()
+            deadline = time.monotonic() + 5
+            while time.monotonic() < deadline:
+                ramp(200_000)
+        kill.join()
+        assert stopped.value.signum == signal.SIGTERM and time.monotonic() < deadline
+        assert sys.getprofile() is None

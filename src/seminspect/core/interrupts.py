@@ -5,8 +5,9 @@ is to die on the spot, leaving whatever was being written claiming to be in prog
 :func:`stop_on_signals` both signals raise :class:`Interrupted` instead, so ``finally`` blocks
 record why the work stopped. :func:`deferred_signals` holds them back for a few lines that must
 not be cut in half (the last status of a run directory). A signal that arrives while numba
-compiles a kernel is delivered again once it has finished: raising inside numba's callbacks
-into Python would be swallowed and crash the process.
+compiles a kernel, or while a compiled kernel calls back into numba's Python code, is delivered
+again once it has left numba: numba drops an exception raised in its callbacks (a compiled call
+then fails with ``SystemError``) or leaves LLVM half-done (a crash follows).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import signal
 import sys
 import threading
 from collections.abc import Iterator
+from pathlib import Path
 from types import FrameType
 
 #: The signals that ask a run to stop, and how a person would name them.
@@ -59,11 +61,30 @@ class _Handler:
             self.pending = self.pending or signum
             return
         if _numba_compiling():
-            # The handler may be running inside numba's ctypes callbacks, where an exception
-            # is swallowed and leaves LLVM half-done (a crash follows): ask again shortly.
-            _redeliver(signum)
+            _redeliver(signum)  # raising in LLVM's callbacks would crash: ask again shortly
+            return
+        if _inside_numba(frame):
+            self._raise_on_leaving_numba(signum)
             return
         raise Interrupted(signum)
+
+    def _raise_on_leaving_numba(self, signum: int) -> None:
+        """Raise at the main thread's first call or return outside numba's code.
+
+        Timing the signal again would not do: a kernel spends its time in compiled code, and
+        the first Python to run when it ends is numba's own again.
+        """
+
+        def on_event(frame: FrameType, event: str, arg: object) -> None:
+            if _inside_numba(frame):
+                return
+            sys.setprofile(None)  # a profiler set before is dropped: Python drops one that raises
+            if self.deferring:
+                self.pending = self.pending or signum
+                return
+            raise Interrupted(signum)
+
+        sys.setprofile(on_event)
 
 
 #: How long a stop signal waits before it is delivered again while numba compiles (s).
@@ -74,6 +95,24 @@ def _numba_compiling() -> bool:
     """Whether numba is compiling now (checked without importing numba)."""
     lock_module = sys.modules.get("numba.core.compiler_lock")
     return lock_module is not None and lock_module.global_compiler_lock.is_locked()
+
+
+def _inside_numba(frame: FrameType | None) -> bool:
+    """Whether numba's or llvmlite's Python code is on the stack ending at ``frame``.
+
+    Compiled kernels call back into Python (to rebuild constants, to box results) through code
+    that ignores an exception raised there.
+    """
+    packages = tuple(
+        f"{Path(module.__file__).parent}{os.sep}"
+        for name in ("numba", "llvmlite")
+        if (module := sys.modules.get(name)) is not None and module.__file__
+    )
+    while packages and frame is not None:
+        if frame.f_code.co_filename.startswith(packages):
+            return True
+        frame = frame.f_back
+    return False
 
 
 def _redeliver(signum: int) -> None:
