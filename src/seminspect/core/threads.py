@@ -117,10 +117,15 @@ def blocks_of(
     """``range(count)`` cut into ``threads * blocks_per_thread`` contiguous blocks of nearly
     equal size, in order; one block when a thread would get fewer than ``min_per_thread`` items
     (below that, splitting costs more than it saves)."""
-    if threads <= 1 or count < 2 * min_per_thread:
+    if not worth_splitting(count, threads, min_per_thread):
         return [slice(0, count)]
-    bounds = np.linspace(0, count, threads * blocks_per_thread + 1).astype(int)
-    return [slice(int(a), int(b)) for a, b in itertools.pairwise(bounds)]
+    blocks = threads * blocks_per_thread
+    return [slice(count * i // blocks, count * (i + 1) // blocks) for i in range(blocks)]
+
+
+def worth_splitting(count: int, threads: int, min_per_thread: int) -> bool:
+    """Whether :func:`blocks_of` cuts ``count`` items into more than one block."""
+    return threads > 1 and count >= 2 * min_per_thread
 
 
 def run_dealt(

@@ -19,7 +19,7 @@ import math
 import numba
 import numpy as np
 
-from seminspect.core.threads import blocks_of, run_dealt
+from seminspect.core.threads import run_dealt, worth_splitting
 
 UNKNOWN = np.uint8(0)
 FREE = np.uint8(1)
@@ -154,7 +154,7 @@ def integrate_rays_kernel(  # noqa: PLR0917 - the compiled kernel's arrays, pass
     """
     arrays = (states, grid_origin, resolution, origins, ends, hit, carve_from)
     count = ends.shape[0]
-    if len(blocks_of(count, threads, MIN_RAYS_PER_THREAD)) == 1:  # one thread: hits at once
+    if not worth_splitting(count, threads, MIN_RAYS_PER_THREAD):  # one thread: hits at once
         _walk_rays(*arrays, 0, count, np.empty(0, dtype=np.int64))
         return
     occupy = np.empty(count, dtype=np.int64)
