@@ -188,3 +188,18 @@ def small_mission_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.fixture(scope="session")
 def small_mission(small_mission_dir: Path) -> SavedRun:
     return SavedRun.read(small_mission_dir)
+
+
+def pytest_terminal_summary(terminalreporter: pytest.TerminalReporter) -> None:
+    """Say which checks the golden mission ran (``tests/missions/test_golden.py``): exact, on a
+    machine with a golden file, and the behavioural envelope, everywhere; or why one skipped."""
+    lines = []
+    for report in terminalreporter.stats.get("passed", []):
+        lines += [str(value) for name, value in report.user_properties if name == "golden check"]
+    for report in terminalreporter.stats.get("skipped", []):
+        if "test_golden.py" in report.nodeid and isinstance(report.longrepr, tuple):
+            lines.append(str(report.longrepr[2]).removeprefix("Skipped: "))
+    if lines:
+        terminalreporter.write_sep("-", "golden mission")
+        for line in lines:
+            terminalreporter.write_line(line)

@@ -1,21 +1,10 @@
 """bench/mission.py judges a mission's real-time factor against the target of its mission."""
 
-import importlib.util
-import sys
-from pathlib import Path
-
-BENCH = Path(__file__).resolve().parents[2] / "bench"
+from bench_scripts import bench_script
 
 
 def _script():
-    sys.path.insert(0, str(BENCH))  # the script imports its sibling mission_profile
-    try:
-        spec = importlib.util.spec_from_file_location("mission_bench", BENCH / "mission.py")
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-    finally:
-        sys.path.remove(str(BENCH))
-    return module
+    return bench_script("mission")
 
 
 def test_the_default_mission_is_held_to_fifty_times_real_time() -> None:

@@ -1,22 +1,17 @@
 """bench/planning_targets.py judges a written planning study against issue 5's targets."""
 
-import importlib.util
 from pathlib import Path
 
 import pytest
 
+from bench_scripts import bench_script
 from seminspect.core.io import read_versioned_json
 from seminspect.studies.planning.tables import STUDY_FORMAT, write_study
 from study_fakes import study
 
-SCRIPT = Path(__file__).resolve().parents[2] / "bench" / "planning_targets.py"
-
 
 def _script():
-    spec = importlib.util.spec_from_file_location("planning_targets", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return bench_script("planning_targets")
 
 
 def _document(tmp_path: Path, vp_s: float) -> dict:

@@ -1,7 +1,23 @@
+import json
+import os
+import re
+import subprocess
+import sys
 from pathlib import Path
 
+import pytest
+
 from seminspect import __version__
-from seminspect.core.provenance import code_differences, code_version, git_revision, source_hash
+from seminspect.core.provenance import (
+    code_differences,
+    code_version,
+    git_revision,
+    numeric_fingerprint,
+    numeric_platform,
+    platform_difference,
+    platform_label,
+    source_hash,
+)
 
 
 def test_the_source_hash_follows_every_python_file(tmp_path: Path) -> None:
@@ -29,17 +45,61 @@ def test_the_record_names_the_package_and_what_changed() -> None:
 
 def test_the_record_names_the_machines_floating_point_paths() -> None:
     platform = code_version()["platform"]
-    assert set(platform) == {"machine", "cpu_vendor", "simd", "blas_kernels"}
+    assert set(platform) == {
+        "machine", "cpu_vendor", "cpu_model", "simd", "blas_kernels", "fingerprint",
+    }  # fmt: skip
     assert platform["machine"]
     # numpy is installed, so its BLAS is found and named.
     assert platform["blas_kernels"]
+    assert re.fullmatch(r"[0-9a-f]{16}", platform["fingerprint"])
+    assert numeric_fingerprint() == platform["fingerprint"]  # the same paths, the same hash
+
+
+def _child_platform(**environment: str) -> dict[str, str]:
+    """``numeric_platform()`` of a fresh interpreter with ``environment`` added."""
+    code = "import json; from seminspect.core.provenance import numeric_platform as p; "
+    code += "print(json.dumps(p()))"
+    done = subprocess.run(
+        [sys.executable, "-c", code],
+        env={**os.environ, **environment},
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=120,
+    )
+    return json.loads(done.stdout)
+
+
+def test_the_fingerprint_tells_other_blas_kernels_apart() -> None:
+    # OpenBLAS's kernels can be forced, which gives this machine another floating-point path
+    # with every named field but one unchanged: the fingerprint must see it too.
+    here = numeric_platform()
+    other_kernels = "Nehalem" if here["blas_kernels"] == "Sandybridge" else "Sandybridge"
+    there = _child_platform(OPENBLAS_CORETYPE=other_kernels)
+    if there["blas_kernels"] == here["blas_kernels"]:
+        pytest.skip("this numpy's OpenBLAS cannot be given other kernels")
+    assert there["fingerprint"] != here["fingerprint"]
+    assert _child_platform() == here  # and a second process on the same paths agrees
+
+
+def test_a_platform_difference_is_named_field_by_field() -> None:
+    was = {"machine": "x86_64", "simd": "avx2", "blas_kernels": "Zen"}
+    now = {"machine": "x86_64", "simd": "avx512f", "blas_kernels": "Zen", "fingerprint": "ab12"}
+    assert platform_difference(was, now) == "simd avx2 -> avx512f, fingerprint unrecorded -> ab12"
+    assert platform_label(now) == "x86_64 avx512f Zen #ab12"
 
 
 def test_a_run_from_another_machine_differs_unless_it_did_not_record_one() -> None:
     record = code_version()
     elsewhere = {**record, "platform": {**record["platform"], "cpu_vendor": "OtherVendor"}}
     (difference,) = code_differences(elsewhere, record)
-    assert difference.startswith("machine ") and "OtherVendor" in difference
+    assert difference == f"machine cpu_vendor OtherVendor -> {record['platform']['cpu_vendor']}"
+    # A run recorded before the fingerprint was cannot vouch for this machine's paths.
+    older = {**record, "platform": {**record["platform"]}}
+    del older["platform"]["fingerprint"]
+    assert code_differences(older, record) == [
+        f"machine fingerprint unrecorded -> {record['platform']['fingerprint']}"
+    ]
     unrecorded = {key: value for key, value in record.items() if key != "platform"}
     assert code_differences(unrecorded, record) == []
 
@@ -47,8 +107,6 @@ def test_a_run_from_another_machine_differs_unless_it_did_not_record_one() -> No
 def test_the_blas_named_is_numpys_whatever_else_is_loaded() -> None:
     import cv2  # noqa: F401 - OpenCV loads an OpenBLAS of its own
     from threadpoolctl import threadpool_info
-
-    from seminspect.core.provenance import numeric_platform
 
     (numpy_blas,) = [
         lib for lib in threadpool_info() if "numpy" in Path(lib["filepath"]).parent.name

@@ -11,6 +11,9 @@ from seminspect.missions.sweep import (
     COLUMNS,
     SweepRow,
     SweepSpec,
+    SweepTask,
+    _gather,
+    charges_wall_time,
     expand,
     load_spec,
     metric_figures,
@@ -92,3 +95,54 @@ def test_groups_get_the_mean_and_spread_of_their_finished_runs(tmp_path) -> None
     assert table[3]["state"] == "failed" and table[3]["rmse_xy_m"] == ""
     markdown = written[2].read_text()
     assert "| a | 4 | 1 |" in markdown and "0.2 ± 0.1" in markdown
+
+
+class _FakeRay:
+    """Enough of Ray for the scheduler: tasks finish in the order they were started, and the
+    tasks in flight are recorded at every start."""
+
+    def __init__(self) -> None:
+        self.started: list[str] = []
+        self.in_flight: list[list[str]] = []
+        self._pending: list[tuple[int, SweepTask]] = []
+
+    def remote(self, **_options):
+        def wrap(function):
+            fake = self
+
+            class Remote:
+                @staticmethod
+                def remote(task: SweepTask) -> int:
+                    fake._pending.append((len(fake.started), task))
+                    fake.started.append(task.name)
+                    fake.in_flight.append([t.name for _, t in fake._pending])
+                    return len(fake.started) - 1
+
+            return Remote
+
+        return wrap
+
+    def wait(self, refs, num_returns):
+        assert num_returns == 1
+        return [min(refs)], []
+
+    def get(self, ref: int) -> SweepRow:
+        ((_, task),) = [entry for entry in self._pending if entry[0] == ref]
+        self._pending.remove((ref, task))
+        return SweepRow(task.name, task.group, int(task.config["seed"]), "completed")
+
+
+def test_missions_that_charge_wall_time_run_first_and_never_beside_each_other(tmp_path) -> None:
+    free = expand(SweepSpec(worlds=["campus"], seeds=[0, 1, 2]), tmp_path)
+    charged = expand(
+        SweepSpec(worlds=["city"], seeds=[0, 1], settings={"charge_planning_time": [True]}),
+        tmp_path,
+    )
+    assert [charges_wall_time(t) for t in free + charged] == [False] * 3 + [True] * 2
+    ray = _FakeRay()
+    rows = _gather(ray, free + charged, None, slots=2)
+    assert [row.name for row in rows] == [t.name for t in free + charged]  # in the tasks' order
+    assert ray.started[0] == charged[0].name  # the charged chain never waits behind the others
+    charged_names = {t.name for t in charged}
+    assert all(len(set(names) & charged_names) <= 1 for names in ray.in_flight)
+    assert max(len(names) for names in ray.in_flight) == 2  # both slots are used

@@ -2,6 +2,8 @@ import pytest
 
 from seminspect.core.errors import FileFormatError
 from seminspect.report.markdown import (
+    mean_sd,
+    median_range,
     replace_sections,
     rewrite_sections,
     section_body,
@@ -69,3 +71,12 @@ def test_a_sections_body_is_read_back_without_its_markers() -> None:
     assert section_body(DOC, "t6") == "old\n"
     with pytest.raises(FileFormatError, match="no section named t5"):
         section_body(DOC, "t5")
+
+
+def test_a_figure_over_seeds_is_mean_and_spread_and_a_count_median_and_range() -> None:
+    assert mean_sd([0.063, 0.067, 0.066], 3) == "0.065 ± 0.002"
+    assert mean_sd([0.07], 3) == "0.070"  # one run has no spread
+    assert mean_sd([None, float("nan")], 1) == "-"
+    assert median_range([150, 155, 167, 152]) == "154 [150-167]"
+    assert median_range([6, 6, 6]) == "6"
+    assert median_range([]) == "-"

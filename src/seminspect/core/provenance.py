@@ -93,21 +93,61 @@ def numeric_platform() -> dict[str, str]:
 
     Embree intersects rays with the widest SIMD instruction set the CPU offers, refining the
     CPU's own reciprocal estimates (which differ between vendors); OpenBLAS picks its kernels
-    by CPU model. Runs of the same code and seed agree bit for bit on machines that agree on
-    every field; elsewhere their distances differ in the last bits, and a mission's path then
-    drifts apart (docs/reproduction.md, "Reproducing on another machine").
+    by CPU model. The named fields say which paths were taken where they can be read; the
+    ``fingerprint`` hashes what those paths compute (:func:`numeric_fingerprint`), so two
+    machines whose paths differ in a way no field names still differ. Runs of the same code
+    and seed agree bit for bit on machines that agree on every field; elsewhere their
+    distances differ in the last bits, and a mission's path then drifts apart
+    (docs/reproduction.md, "Reproducing on another machine").
     """
     import numpy  # noqa: F401, PLC0415 - loads the BLAS that threadpool_info looks for
 
-    vendor, flags = _cpu_identity()
+    fields = _cpu_identity()
+    flags = set(fields.get("flags", "").split())
     simd = next((level for level in _SIMD_LEVELS if level in flags), "none" if flags else "")
-    blas = _numpy_blas_architecture()
     return {
         "machine": platform.machine(),
-        "cpu_vendor": vendor or platform.processor(),
+        "cpu_vendor": fields.get("vendor_id") or platform.processor(),
+        "cpu_model": fields.get("model name", ""),
         "simd": simd,
-        "blas_kernels": blas,
+        "blas_kernels": _numpy_blas_architecture(),
+        "fingerprint": numeric_fingerprint(),
     }
+
+
+#: Rays of the fingerprint's Embree cast, and the side of its BLAS products.
+_FINGERPRINT_RAYS = 4096
+_FINGERPRINT_MATRIX = 96
+
+
+def numeric_fingerprint() -> str:
+    """A short hash of a fixed Embree ray cast and fixed BLAS products, the two floating-point
+    paths measured to move a mission's figures (docs/reproduction.md): machines with the same
+    hash computed both bit for bit alike.
+
+    The cast goes through ``embreex``, whose hits the missions' own Embree calls reproduce bit
+    for bit (``worlds/embree.py``); the rays meet a subdivided sphere at every angle, from
+    inside and outside, so that ray-triangle tests of every slope enter the hash.
+    """
+    import numpy as np  # noqa: PLC0415 - heavy, and only needed here
+    import trimesh  # noqa: PLC0415
+    from embreex import rtcore_scene  # noqa: PLC0415
+    from embreex.mesh_construction import TriangleMesh  # noqa: PLC0415
+
+    sphere = trimesh.creation.icosphere(subdivisions=3, radius=1.7)
+    scene = rtcore_scene.EmbreeScene()
+    TriangleMesh(scene, sphere.vertices.astype(np.float32), sphere.faces.astype(np.int32))
+    rng = np.random.default_rng(20261201)
+    origins = rng.uniform(-3.0, 3.0, (_FINGERPRINT_RAYS, 3)).astype(np.float32)
+    directions = rng.normal(size=(_FINGERPRINT_RAYS, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    hits = scene.run(origins, directions.astype(np.float32), output=1)
+    a = rng.normal(size=(_FINGERPRINT_MATRIX, _FINGERPRINT_MATRIX))
+    b = rng.normal(size=(_FINGERPRINT_MATRIX, _FINGERPRINT_MATRIX))
+    digest = hashlib.sha256()
+    for part in (hits["tfar"], hits["primID"], a @ b, a.astype(np.float32) @ b.astype(np.float32)):
+        digest.update(np.ascontiguousarray(part).tobytes())
+    return digest.hexdigest()[:16]
 
 
 def _numpy_blas_architecture() -> str:
@@ -118,17 +158,18 @@ def _numpy_blas_architecture() -> str:
     return str(numpy_first[0].get("architecture", "")) if numpy_first else ""
 
 
-def _cpu_identity() -> tuple[str, set[str]]:
-    """The CPU's vendor and feature flags as Linux reports them (empty elsewhere)."""
+def _cpu_identity() -> dict[str, str]:
+    """The first processor's fields (vendor, model name, feature flags) as Linux reports them
+    (empty elsewhere)."""
     try:
         text = Path("/proc/cpuinfo").read_text(encoding="utf-8", errors="replace")
     except OSError:
-        return "", set()
+        return {}
     fields: dict[str, str] = {}
     for line in text.splitlines():
         key, _, value = line.partition(":")
         fields.setdefault(key.strip(), value.strip())
-    return fields.get("vendor_id", ""), set(fields.get("flags", "").split())
+    return fields
 
 
 def code_version() -> dict[str, Any]:
@@ -157,15 +198,35 @@ def code_differences(recorded: dict[str, Any], current: dict[str, Any]) -> list[
     # Records from before the platform was recorded cannot tell; they are taken at their word.
     was, now = recorded.get("platform"), current.get("platform")
     if was and now and was != now:
-        differences.append(f"machine {platform_label(was)} -> {platform_label(now)}")
+        differences.append(f"machine {platform_difference(was, now)}")
     return differences
 
 
-def platform_label(fields: dict[str, str]) -> str:
-    """A :func:`numeric_platform` record in a few words, e.g. ``x86_64 GenuineIntel avx512f``."""
-    return " ".join(
-        fields[key] for key in ("machine", "cpu_vendor", "simd", "blas_kernels") if fields.get(key)
+def platform_difference(was: dict[str, str], now: dict[str, str]) -> str:
+    """How two :func:`numeric_platform` records differ, field by field (``unrecorded`` where
+    one of them lacks the field), e.g. ``simd avx2 -> avx512f``."""
+    keys = [key for key in _PLATFORM_KEYS if key in was or key in now]
+    keys += sorted((set(was) | set(now)) - set(keys))
+    return ", ".join(
+        f"{key} {was.get(key, 'unrecorded')} -> {now.get(key, 'unrecorded')}"
+        for key in keys
+        if was.get(key) != now.get(key)
     )
+
+
+#: The fields of :func:`numeric_platform`, in the order labels name them.
+_PLATFORM_KEYS = ("machine", "cpu_vendor", "cpu_model", "simd", "blas_kernels", "fingerprint")
+
+
+def platform_label(fields: dict[str, str]) -> str:
+    """A :func:`numeric_platform` record in a few words, e.g. ``x86_64 GenuineIntel avx512f
+    SkylakeX`` (with its fingerprint's first digits where recorded)."""
+    words = [
+        fields[key] for key in ("machine", "cpu_vendor", "simd", "blas_kernels") if fields.get(key)
+    ]
+    if fields.get("fingerprint"):
+        words.append(f"#{fields['fingerprint'][:8]}")
+    return " ".join(words)
 
 
 def _short(digest: Any) -> str:

@@ -243,6 +243,8 @@ def run_on_ray(
 
     Without ``address`` a local Ray starts with ``workers`` CPUs (default: every core) and stops
     at the end; with one, the tasks go to that cluster, whose workers need seminspect installed.
+    Missions that charge planning wall time to the robot (``charge_planning_time``) run one at a
+    time, beside the others but never beside each other (:func:`_schedule`).
     """
     ray = _ray()
     if workers is not None and workers < 1:
@@ -259,19 +261,52 @@ def run_on_ray(
         except (ConnectionError, RuntimeError, ValueError) as exc:
             raise InvalidInputError(f"cannot start or reach Ray ({exc})") from None
     try:
-        return _gather(ray, tasks, on_row)
+        slots = workers or max(1, int(ray.cluster_resources().get("CPU", 1)))
+        return _gather(ray, tasks, on_row, slots)
     finally:
         if started_here:
             ray.shutdown()
 
 
-def _gather(ray, tasks: Sequence[SweepTask], on_row) -> list[SweepRow]:
+def charges_wall_time(task: SweepTask) -> bool:
+    """Whether the task's robot waits for its planners' wall time: such a mission's figures
+    move with the machine's load, so two of them never share the machine."""
+    return bool(task.config.get("charge_planning_time"))
+
+
+def _schedule(tasks: Sequence[SweepTask], running: Sequence[int]) -> Callable[[], int | None]:
+    """The index of the next task to start given the indices ``running`` (a live view), or
+    ``None`` to wait: a wall-time-charging task first whenever none runs (their chain is the
+    longest, so it must never wait behind the others), else the next of the others."""
+    charged = [i for i, task in enumerate(tasks) if charges_wall_time(task)]
+    others = [i for i, task in enumerate(tasks) if not charges_wall_time(task)]
+    charged.reverse()
+    others.reverse()
+
+    def next_index() -> int | None:
+        if charged and not any(charges_wall_time(tasks[i]) for i in running):
+            return charged.pop()
+        return others.pop() if others else None
+
+    return next_index
+
+
+def _gather(ray, tasks: Sequence[SweepTask], on_row, slots: int) -> list[SweepRow]:
+    """Run the tasks with at most ``slots`` in flight, in the order of :func:`_schedule`."""
     remote = ray.remote(num_cpus=1, max_retries=0)(run_task)
-    pending = {remote.remote(task): index for index, task in enumerate(tasks)}
+    pending: dict[Any, int] = {}
+    running: list[int] = []
+    next_index = _schedule(tasks, running)
     rows: list[SweepRow | None] = [None] * len(tasks)
-    while pending:
+    while True:
+        while len(pending) < slots and (index := next_index()) is not None:
+            pending[remote.remote(tasks[index])] = index
+            running.append(index)
+        if not pending:
+            break
         done, _ = ray.wait(list(pending), num_returns=1)
         index = pending.pop(done[0])
+        running.remove(index)
         try:
             row = ray.get(done[0])
         except Exception as exc:  # the worker itself died (killed, out of memory)

@@ -2,14 +2,18 @@
 
 A section is the text between ``<!-- BEGIN table:NAME -->`` and ``<!-- END table:NAME -->``
 lines; everything outside the markers is left as written, so prose and the paper's own rows
-stay hand-edited while measured tables are regenerated (``bench/reproduction.py``).
+stay hand-edited while measured tables are regenerated (``bench/reproduction.py``). Tables
+over seeds give continuous figures as mean ± standard deviation (:func:`mean_sd`) and counts as
+median and range (:func:`median_range`).
 """
 
 from __future__ import annotations
 
+import math
 import os
 import re
-from collections.abc import Callable, Mapping
+import statistics
+from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 
 from seminspect.core.errors import FileFormatError
@@ -85,3 +89,30 @@ def rewrite_sections(path: str | os.PathLike[str], sections: Mapping[str, str]) 
         return atomic_write_text(path, replace_sections(text, sections))
     except FileFormatError as exc:
         raise FileFormatError(f"{path}: {exc}") from exc
+
+
+# --- cells of tables over seeds ---------------------------------------------------------------
+def _finite(values: Iterable[float | None]) -> list[float]:
+    return [float(v) for v in values if v is not None and math.isfinite(v)]
+
+
+def mean_sd(values: Iterable[float | None], digits: int) -> str:
+    """``mean ± sample standard deviation`` of the finite values, each to ``digits`` decimals
+    (the mean alone for one value, ``-`` for none): a continuous figure over seeds."""
+    finite = _finite(values)
+    if not finite:
+        return "-"
+    mean = f"{statistics.fmean(finite):.{digits}f}"
+    return mean if len(finite) == 1 else f"{mean} ± {statistics.stdev(finite):.{digits}f}"
+
+
+def median_range(values: Iterable[float | None], digits: int = 0) -> str:
+    """``median [min-max]`` of the finite values (the median alone where all agree, ``-`` for
+    none): a count over seeds."""
+    finite = _finite(values)
+    if not finite:
+        return "-"
+    low, middle, high = (
+        f"{v:.{digits}f}" for v in (min(finite), statistics.median(finite), max(finite))
+    )
+    return middle if low == high else f"{middle} [{low}-{high}]"

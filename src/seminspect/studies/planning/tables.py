@@ -23,6 +23,7 @@ from matplotlib.figure import Figure
 from seminspect.core.io import atomic_write_text, finite_or_none, write_versioned_json
 from seminspect.missions.config import inspects
 from seminspect.report.figures import new_figure, save_figure
+from seminspect.report.markdown import mean_sd
 from seminspect.studies.planning.scaling import ScalingPoint
 from seminspect.studies.planning.study import (
     CITY_SCENARIOS,
@@ -325,18 +326,9 @@ def _other_planner(planner: str) -> str:
     return "volumetric" if planner == "hierarchical" else "hierarchical"
 
 
-def _spread(values: Iterable[float | None], digits: int) -> str:
-    """Mean, and the range over the runs in square brackets where they differ."""
-    summary = stats(values)
-    if summary["n"] == 0:
-        return "-"
-    low, high = _num(summary["min"], digits), _num(summary["max"], digits)
-    return _num(summary["mean"], digits) + (f" [{low}-{high}]" if low != high else "")
-
-
 def table6_summary(outcomes: Sequence[MissionOutcome]) -> str:
-    """One row per scenario and planner over the seeds: mean [min-max], the paper's figure in
-    brackets where 000 Table 6 gives one."""
+    """One row per scenario and planner over the seeds: mean ± standard deviation, the paper's
+    figure in brackets where 000 Table 6 gives one."""
     lines = [
         "| Scenario | Planner | seeds | planning load % | CPU load % (paper) "
         "| coverage m³ (paper) | RMSE m, own targets (paper) | RMSE m, common targets "
@@ -352,11 +344,11 @@ def table6_summary(outcomes: Sequence[MissionOutcome]) -> str:
         inspected = "; ".join(f"{_scored_count(o)} / {o.true_targets}" for o in runs)
         lines.append(
             f"| {scenario} | {planner} | {', '.join(str(o.seed) for o in runs)} "
-            f"| {_spread((o.planning_load_pct for o in runs), 3)} "
-            f"| {_spread((o.cpu_load_pct for o in runs), 1)} ({_num(cpu, 1)}) "
-            f"| {_spread((o.bbox_volume_m3 for o in runs), 1)} ({_num(cover, 1)}) "
-            f"| {_spread((o.rmse_m for o in runs), 3)} ({_num(rmse, 3)}) "
-            f"| {_num(common, 3)} | {inspected} | {_spread((o.sim_time_s for o in runs), 0)} |"
+            f"| {mean_sd((o.planning_load_pct for o in runs), 3)} "
+            f"| {mean_sd((o.cpu_load_pct for o in runs), 1)} ({_num(cpu, 1)}) "
+            f"| {mean_sd((o.bbox_volume_m3 for o in runs), 1)} ({_num(cover, 1)}) "
+            f"| {mean_sd((o.rmse_m for o in runs), 3)} ({_num(rmse, 3)}) "
+            f"| {_num(common, 3)} | {inspected} | {mean_sd((o.sim_time_s for o in runs), 0)} |"
         )
     return "\n".join(lines) + "\n"
 
