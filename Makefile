@@ -1,7 +1,7 @@
 # Entry points for a fresh machine; each builds the virtual environment it needs.
 #   make mission     install seminspect, compile its kernels, run the default inspection mission
 #   make test        install seminspect with test tools and run the test suite
-#   make reproduce   regenerate every measured table of docs/reproduction.md (about an hour on 2 cores)
+#   make reproduce   regenerate every measured table of docs/reproduction.md (45 minutes on 2 cores)
 #   make lock        rewrite requirements.lock from the versions installed in .venv
 # Installs take the exact versions of requirements.lock (the ones behind the published
 # figures); pyproject.toml keeps version ranges for people who use seminspect as a library.
