@@ -52,10 +52,13 @@ def read_runs(path: Path) -> Runs:
     if not rows or "group" not in rows[0]:
         raise SystemExit(f"{table} is not a sweep table (no 'group' column)")
     runs: Runs = {}
-    for row in rows:
-        if row["state"] == "failed":
+    for line, row in enumerate(rows, start=2):
+        if row.get("state") == "failed":
             continue
-        figures = {name: float(row[name]) for name in BEHAVIOUR if row.get(name) not in (None, "")}
+        try:
+            figures = {n: float(row[n]) for n in BEHAVIOUR if row.get(n) not in (None, "")}
+        except ValueError as exc:
+            raise SystemExit(f"{table}, line {line}: {exc}") from None
         runs.setdefault(row["group"], []).append(figures)
     return runs
 

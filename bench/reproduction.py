@@ -164,14 +164,6 @@ def machine_line(group: Iterable[tuple[SweepTask, dict[str, Any]]]) -> str:
     return "Machine: " + "; ".join(named) + "."
 
 
-def seeds_cell(seeds: Sequence[int]) -> str:
-    seeds = sorted(seeds)
-    contiguous = seeds == list(range(seeds[0], seeds[-1] + 1))
-    return (
-        f"{seeds[0]}-{seeds[-1]}" if contiguous and len(seeds) > 2 else ", ".join(map(str, seeds))
-    )
-
-
 # --- 000 Table 3 ---------------------------------------------------------------------------
 HEADER = (
     "| run | seeds | Target | Level | Pose | Feature | Unified | Reconciled % "
@@ -195,7 +187,7 @@ def table3_row(name: str, runs: list[tuple[SweepTask, dict[str, Any]]]) -> str:
     ]
     cells = [
         name,
-        seeds_cell(seeds),
+        missions.seeds_cell(seeds),
         *layers,
         mean_sd((t["reconciled_pct"] for t in t3), 1),
         _pair(t3, lambda t: t["detected_pct"], lambda t: t["inspected_pct"]),
@@ -331,7 +323,8 @@ def team_section(runs: Runs) -> str:
         for s in seeds
     )
     lines.append(
-        f"| {seeds_cell(seeds)} | {cell(lone, 'finish_s')} | {cell(lone, 'last_inspection_s')} "
+        f"| {missions.seeds_cell(seeds)} | {cell(lone, 'finish_s')} "
+        f"| {cell(lone, 'last_inspection_s')} "
         f"| {cell(team, 'finish_s')} | {cell(team, 'last_inspection_s')} "
         f"| {cell(team, 'exploration_done_s')} | {mean_sd(ratio.values(), 2)} | {outcome} |"
     )

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import argparse
 import time
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 
 from seminspect.missions.config import CITY_BUDGETS
@@ -32,6 +32,15 @@ CITY_SCENARIOS = ("small", "medium", "large")
 TEAM = ("explorer", "inspector")
 TEAM_SCENARIO = "large"
 RUNS = Path("runs/reproduction/missions")
+
+
+def seeds_cell(seeds: Sequence[int]) -> str:
+    """How a table names its seeds: ``0-4`` for a run of three or more, else ``0, 2``."""
+    seeds = sorted(seeds)
+    contiguous = seeds == list(range(seeds[0], seeds[-1] + 1))
+    return (
+        f"{seeds[0]}-{seeds[-1]}" if contiguous and len(seeds) > 2 else ", ".join(map(str, seeds))
+    )
 
 
 def _table3_specs() -> dict[str, list[SweepSpec]]:

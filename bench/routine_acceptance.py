@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from reproduction_missions import seeds_cell
 from seminspect.core.rng import make_rng
 from seminspect.missions.routine import RoutineConfig
 from seminspect.missions.routine_run import PRIOR_FILE, run_routine
@@ -128,13 +129,6 @@ def run_studies(out: Path, seeds: tuple[int, ...] = SEEDS) -> dict:
     return results
 
 
-def _seeds(seeds: list[int]) -> str:
-    contiguous = seeds == list(range(seeds[0], seeds[-1] + 1))
-    return (
-        f"{seeds[0]}-{seeds[-1]}" if contiguous and len(seeds) > 2 else ", ".join(map(str, seeds))
-    )
-
-
 def single_table(results: dict) -> str:
     """Nominal and obstructed runs over the seeds."""
     lines = [
@@ -145,7 +139,8 @@ def single_table(results: dict) -> str:
     for scenario, runs in results["single"].items():
         ms = list(runs.values())
         lines.append(
-            f"| {scenario} | {_seeds(list(runs))} | {mean_sd((m['gamma_s_max'] for m in ms), 2)} "
+            f"| {scenario} | {seeds_cell(list(runs))} "
+            f"| {mean_sd((m['gamma_s_max'] for m in ms), 2)} "
             f"| {mean_sd((m['viewpoint_utility_mean'] for m in ms), 3)} "
             f"| {mean_sd((m['view_distance_mae_m'] for m in ms), 2)} "
             f"| {mean_sd((m['roi_coverage_pct'] for m in ms), 1)} "
@@ -179,7 +174,7 @@ def pair_table(results: dict) -> str:
             )
 
         lines.append(
-            f"| {scenario} | {_seeds(list(pairs))} | {mean_sd(map(_change_m, a), 2)} "
+            f"| {scenario} | {seeds_cell(list(pairs))} | {mean_sd(map(_change_m, a), 2)} "
             f"| {mean_sd((m['gamma_s_max'] for m in a), 2)} "
             f"| {both('view_distance_mae_after_deviation_m', 2)} "
             f"| {both('viewpoint_utility_mean', 3)} | {both('roi_coverage_pct', 1)} "

@@ -31,7 +31,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from seminspect.core.rng import make_rng
-from seminspect.missions.config import inspection_params, make_config, resolve
+from seminspect.missions.config import make_config, resolve
 from seminspect.missions.platform import mission_noise
 from seminspect.missions.run import camera_pitch
 from seminspect.perception.similarity import (
@@ -67,7 +67,7 @@ class Rig:
     @classmethod
     def of(cls, world_name: str, scenario: str, seed: int) -> Rig:
         config = resolve(make_config({"world": world_name, "scenario": scenario, "seed": seed}))
-        params = inspection_params(config)
+        params = config.params
         aerial = config.mode == "aerial"
         return cls(
             world=generate_world(world_name, scenario, seed=seed),

@@ -98,3 +98,10 @@ def test_the_published_runs_hold_at_least_five_seeds_a_group() -> None:
     published = compare_runs.read_runs(REPO / "docs/data/reproduction/sweep.csv")
     assert published and all(len(runs) >= 5 for runs in published.values())
     assert not any(c.flagged for c in compare_runs.compare(published, published))
+
+
+def test_a_figure_that_is_not_a_number_is_named_by_its_line(tmp_path: Path) -> None:
+    table = tmp_path / "sweep.csv"
+    table.write_text("run,group,seed,state,rmse_xy_m\na,g,0,completed,abc\n", encoding="utf-8")
+    with pytest.raises(SystemExit, match=r"sweep.csv, line 2: could not convert"):
+        compare_runs.read_runs(table)
