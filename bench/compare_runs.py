@@ -31,7 +31,7 @@ from pathlib import Path
 
 from scipy.stats import mannwhitneyu
 
-from seminspect.missions.sweep import COLUMNS
+from seminspect.missions.xflie.sweep import COLUMNS
 
 #: Columns that measure the machine's speed and load, not the mission's behaviour.
 WALL_CLOCK = frozenset({"avg_planning_ms", "cpu_load_pct", "planning_load_pct"})

@@ -22,8 +22,8 @@ from pathlib import Path
 
 MISSION = """
 import sys, time
-from seminspect.missions.config import make_config
-from seminspect.missions.run import run_mission
+from seminspect.missions.xflie.config import make_config
+from seminspect.missions.xflie.run import run_mission
 t0 = time.perf_counter()
 result = run_mission(make_config({{"world": {world!r}, "scenario": {scenario!r}, "seed": 0}}),
                      sys.argv[1])

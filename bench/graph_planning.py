@@ -27,9 +27,9 @@ import numpy as np
 
 from seminspect.graphs.lsg.networkx_view import traversable_networkx
 from seminspect.graphs.lsg.synthetic import synthetic_graph
-from seminspect.planning.graph_search import CsrGraph, shortest_path
+from seminspect.planning.graph_astar import CsrGraph, shortest_path
 from seminspect.planning.hierarchical import HierarchicalPlanner
-from seminspect.studies.planning.scaling import random_queries
+from seminspect.studies.xflie.scaling import random_queries
 
 
 def flat_csr(flat: nx.Graph) -> tuple[CsrGraph, dict[str, int]]:

@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from seminspect.core.rng import make_rng
 from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap
 from seminspect.planning.gridmap import CostModel
-from seminspect.planning.local import LocalPlanner
+from seminspect.planning.routes import LocalPlanner
 from seminspect.planning.smoothing import refine_path, voxel_segment_checker
 from seminspect.planning.volumetric import ENGINES, VolumetricPlanner
 

@@ -19,8 +19,8 @@ import tempfile
 import time
 
 from mission_profile import outcome
-from seminspect.missions.config import make_config
-from seminspect.missions.run import run_mission
+from seminspect.missions.xflie.config import make_config
+from seminspect.missions.xflie.run import run_mission
 
 #: Real-time factors the benchmarked missions must reach: city large since the first speed
 #: work, city medium (the default mission, first run after install included) since issue 16.

@@ -22,9 +22,9 @@ import sys
 from collections.abc import Iterator
 from pathlib import Path
 
-from seminspect.missions.config import make_config, resolve
-from seminspect.missions.run import run_mission
-from seminspect.missions.rundir import read_metrics_document, reusable_run
+from seminspect.missions.xflie.config import make_config, resolve
+from seminspect.missions.xflie.run import run_mission
+from seminspect.runs.directory import read_metrics_document, reusable_run
 
 CITY = [("city", scenario, seed) for scenario in ("small", "medium", "large") for seed in (0, 1, 2)]
 OTHERS = [

@@ -38,9 +38,10 @@ from functools import wraps
 from typing import Any
 
 from seminspect.mapping import voxel
-from seminspect.missions import metrics, platform, run
-from seminspect.missions.config import make_config
-from seminspect.missions.run import run_mission
+from seminspect.missions.xflie import metrics, run
+from seminspect.missions.xflie.config import make_config
+from seminspect.missions.xflie.run import run_mission
+from seminspect.platform import simulated as platform
 from seminspect.sensors import NoiseModel, camera
 from seminspect.worlds import raycast
 

@@ -21,8 +21,8 @@ from pathlib import Path
 from typing import Any
 
 from seminspect.core.io import read_versioned_json
-from seminspect.studies.planning.scaling import growth_exponent
-from seminspect.studies.planning.tables import STUDY_FORMAT
+from seminspect.studies.xflie.scaling import growth_exponent
+from seminspect.studies.xflie.tables import STUDY_FORMAT
 
 TIME_RATIO = 1000.0
 REFINED_LENGTH = 1.15

@@ -50,17 +50,17 @@ from rl_reproduction import SECTIONS as RL_SECTIONS
 from rl_reproduction import regenerate as rl_regenerate
 from seminspect.core.io import atomic_write_text
 from seminspect.core.provenance import platform_label
-from seminspect.missions.rundir import read_metrics_document
-from seminspect.missions.sweep import SweepRow, SweepTask, sweep_tables
+from seminspect.missions.xflie.sweep import SweepRow, SweepTask, sweep_tables
 from seminspect.report.markdown import mean_sd, median_range, rewrite_sections, section_body
-from seminspect.studies.planning.scaling import SCALING_SIZES, scaling_study
-from seminspect.studies.planning.study import (
+from seminspect.runs.directory import read_metrics_document
+from seminspect.studies.xflie.scaling import SCALING_SIZES, scaling_study
+from seminspect.studies.xflie.study import (
     TABLE6_PLANNERS,
     MissionOutcome,
     PlanningStudy,
     compare_run,
 )
-from seminspect.studies.planning.tables import (
+from seminspect.studies.xflie.tables import (
     both_volumes_beside_paper,
     merge_table6_rows,
     scaling_markdown,

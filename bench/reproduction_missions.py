@@ -2,7 +2,7 @@
 
 The tables report statistics over seeds (``SEEDS``, at least five per row; the golden
 envelope's city small missions take ``ENVELOPE_SEEDS``), so their missions are many and
-independent: they run as one :mod:`seminspect.missions.sweep` on a local Ray, a mission per
+independent: they run as one :mod:`seminspect.missions.xflie.sweep` on a local Ray, a mission per
 core, each into its own run directory under the sweep's directory, where a completed run of
 the same configuration, code and machine is reused. Table 6's missions charge planning wall
 time to the robot's clock; the sweep runs those one at a time (beside the others, never beside
@@ -19,9 +19,9 @@ import time
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
-from seminspect.missions.config import CITY_BUDGETS
-from seminspect.missions.sweep import SweepRow, SweepSpec, SweepTask, expand, run_on_ray
-from seminspect.studies.planning.study import TABLE6_PLANNERS
+from seminspect.missions.xflie.config import CITY_BUDGETS
+from seminspect.missions.xflie.sweep import SweepRow, SweepSpec, SweepTask, expand, run_on_ray
+from seminspect.studies.xflie.study import TABLE6_PLANNERS
 
 #: Seeds of every mission row of the tables.
 SEEDS = tuple(range(5))

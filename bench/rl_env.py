@@ -22,8 +22,8 @@ import time
 
 import numpy as np
 
-from seminspect.learning.baselines import OrbitController, RandomController
-from seminspect.learning.env import EnvConfig, InspectionVectorEnv, _sensor_rays
+from seminspect.missions.learning.baselines import OrbitController, RandomController
+from seminspect.missions.learning.env import EnvConfig, InspectionVectorEnv, _sensor_rays
 
 #: Timed steps per room count: about the same number of room-steps for each.
 STEPS = {1: 600, 8: 150, 64: 40}

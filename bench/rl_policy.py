@@ -23,14 +23,14 @@ from pathlib import Path
 import torch
 
 from seminspect.core.io import atomic_write_text, dumps_json
-from seminspect.learning.policy import (
+from seminspect.missions.learning.policy import (
     DEPTH_SHAPE,
     MAPS_SHAPE,
     STATE_SIZE,
     InspectionPolicy,
     PolicyConfig,
 )
-from seminspect.learning.ppo import save_checkpoint
+from seminspect.missions.learning.ppo import save_checkpoint
 
 PAPER_ONBOARD_MS = 100.0  # 004: one inference step on the robot's Jetson
 

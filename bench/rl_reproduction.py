@@ -28,14 +28,14 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from seminspect.learning.agent import load_controller, shipped_policy_path
-from seminspect.learning.baselines import Controller, OrbitController, RandomController
-from seminspect.learning.evaluation import EvaluationResult, evaluate
-from seminspect.learning.rooms import TABLE1_OBSTACLES
+from seminspect.missions.learning.agent import load_controller, shipped_policy_path
+from seminspect.missions.learning.baselines import Controller, OrbitController, RandomController
+from seminspect.missions.learning.evaluation import EvaluationResult, evaluate
+from seminspect.missions.learning.rooms import TABLE1_OBSTACLES
 from seminspect.report.figures import save_figure
 from seminspect.report.markdown import rewrite_sections
 from seminspect.report.rl import coverage_figure, training_figure
-from seminspect.report.rl_tables import (
+from seminspect.studies.learning.tables import (
     ABLATION_OBSTACLES,
     NEEDS,
     SECTIONS,

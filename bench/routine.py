@@ -23,10 +23,10 @@ import numpy as np
 
 from seminspect.geometry.paths import discrete_frechet, kabsch
 from seminspect.mapping.voxel import VoxelMap
-from seminspect.missions.routine import LIDAR, RoutineConfig, make_robot
-from seminspect.missions.routine_run import run_routine
-from seminspect.missions.routine_tasks import default_tasks
-from seminspect.planning.adaptive import plan_cycle, predict_local_path
+from seminspect.missions.routine.executive import LIDAR, RoutineConfig, make_robot
+from seminspect.missions.routine.run import run_routine
+from seminspect.missions.routine.tasks import default_tasks
+from seminspect.planning.adaptive_cycle import plan_cycle, predict_local_path
 from seminspect.planning.global_views import global_view_plan
 from seminspect.worlds.routine_sites import mine_drift_site
 

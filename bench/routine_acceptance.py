@@ -28,8 +28,8 @@ import numpy as np
 
 from reproduction_missions import seeds_cell
 from seminspect.core.rng import make_rng
-from seminspect.missions.routine import RoutineConfig
-from seminspect.missions.routine_run import PRIOR_FILE, run_routine
+from seminspect.missions.routine.executive import RoutineConfig
+from seminspect.missions.routine.run import PRIOR_FILE, run_routine
 from seminspect.planning.global_views import InspectionRegion, grid_points
 from seminspect.planning.tour import annealed_tour, reference_tour
 from seminspect.report.markdown import mean_sd, median_range

@@ -31,15 +31,15 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from seminspect.core.rng import make_rng
-from seminspect.missions.config import make_config, resolve
-from seminspect.missions.platform import mission_noise
-from seminspect.missions.run import camera_pitch
+from seminspect.missions.xflie.config import make_config, resolve
+from seminspect.missions.xflie.run import camera_pitch
 from seminspect.perception.similarity import (
     ORB_GAMMA_THRESHOLD,
     ImageFeatures,
     SceneMatcher,
     scene_similarity,
 )
+from seminspect.platform.simulated import mission_noise
 from seminspect.sensors import CameraModel, render
 from seminspect.worlds import World
 from seminspect.worlds.catalog import generate_world

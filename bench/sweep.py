@@ -16,7 +16,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from seminspect.missions.sweep import SweepSpec, expand, run_on_ray
+from seminspect.missions.xflie.sweep import SweepSpec, expand, run_on_ray
 
 
 def measure(missions: int, budget: float, workers: int) -> dict[str, float]:

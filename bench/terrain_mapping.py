@@ -17,7 +17,7 @@ import time
 
 import numpy as np
 
-from seminspect.missions.terrain_mapping import map_world
+from seminspect.missions.terrain.mapping import map_world
 from seminspect.perception.encoders import CaptionEncoder, MiniLMTextEncoder
 from seminspect.worlds import generate_world
 

@@ -17,10 +17,10 @@ from seminspect.core.io import read_versioned_json
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.io import load_graph
 from seminspect.mapping.voxel import VoxelMap, load_map
-from seminspect.missions.config import ResolvedMissionConfig, make_config, resolve
-from seminspect.missions.metrics import MissionMetrics, QueryAnswer
-from seminspect.missions.run import run_mission
-from seminspect.missions.rundir import load_trajectory, read_run_config
+from seminspect.missions.xflie.config import ResolvedMissionConfig, make_config, resolve
+from seminspect.missions.xflie.metrics import MissionMetrics, QueryAnswer
+from seminspect.missions.xflie.run import run_mission
+from seminspect.runs.directory import load_trajectory, read_run_config
 from seminspect.worlds import World, generate_world
 
 REPO = Path(__file__).resolve().parents[1]

@@ -1,4 +1,4 @@
-"""A fake :class:`~seminspect.missions.platform.Platform` and a mission context around it.
+"""A fake :class:`~seminspect.platform.simulated.Platform` and a mission context around it.
 
 The fake robot teleports (a move takes its distance at 1 m/s), sees nothing but a scripted
 intensity image, and reports the detections a test hands it. The phase tests of
@@ -18,13 +18,13 @@ from numpy.typing import ArrayLike, NDArray
 from seminspect.geometry.transforms import quat_from_yaw, wrap_angle
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.mapping.voxel import FREE, VoxelMap
-from seminspect.missions.config import ResolvedMissionConfig, make_config, resolve
-from seminspect.missions.metrics import CoverageRecorder
-from seminspect.missions.navigation import Navigator
-from seminspect.missions.platform import Motion
-from seminspect.missions.recorder import MissionRecorder
 from seminspect.missions.xflie.approach import local_planner
+from seminspect.missions.xflie.config import ResolvedMissionConfig, make_config, resolve
 from seminspect.missions.xflie.context import MissionContext
+from seminspect.missions.xflie.metrics import CoverageRecorder
+from seminspect.missions.xflie.navigation import Navigator
+from seminspect.missions.xflie.recorder import MissionRecorder
+from seminspect.platform.protocol import Motion
 from seminspect.sensors import CameraModel, Detection, Frame, LidarScan
 
 #: A small camera keeps the fake's frames cheap (and large enough for ORB features).

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from seminspect.core.rng import make_rng
-from seminspect.learning.policy import DEPTH_SHAPE, MAPS_SHAPE, STATE_SIZE
+from seminspect.missions.learning.policy import DEPTH_SHAPE, MAPS_SHAPE, STATE_SIZE
 
 
 class TargetReachEnv:

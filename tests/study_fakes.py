@@ -5,9 +5,9 @@ from pathlib import Path
 
 import numpy as np
 
-from seminspect.studies.planning.comparison import HierarchicalTiming, VolumetricResult
-from seminspect.studies.planning.scaling import ScalingPoint
-from seminspect.studies.planning.study import (
+from seminspect.studies.xflie.comparison import HierarchicalTiming, VolumetricResult
+from seminspect.studies.xflie.scaling import ScalingPoint
+from seminspect.studies.xflie.study import (
     RESOLUTIONS,
     MissionOutcome,
     PathCheck,

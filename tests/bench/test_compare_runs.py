@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from bench_scripts import bench_script
-from seminspect.missions.sweep import SweepRow, sweep_tables
+from seminspect.missions.xflie.sweep import SweepRow, sweep_tables
 
 REPO = Path(__file__).resolve().parents[2]
 #: The envelope's figures under the sweep's column names.

@@ -6,7 +6,7 @@ import pytest
 
 from bench_scripts import bench_script
 from seminspect.core.io import read_versioned_json
-from seminspect.studies.planning.tables import STUDY_FORMAT, write_study
+from seminspect.studies.xflie.tables import STUDY_FORMAT, write_study
 from study_fakes import study
 
 

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from bench_scripts import bench_script
-from seminspect.missions.sweep import SweepTask
+from seminspect.missions.xflie.sweep import SweepTask
 
 reproduction = bench_script("reproduction")
 

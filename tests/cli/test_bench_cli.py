@@ -3,7 +3,7 @@ from pathlib import Path
 import pytest
 
 from cli_runner import run
-from seminspect.studies.planning import study as planning_study
+from seminspect.studies.xflie import study as planning_study
 from study_fakes import study
 
 

@@ -52,8 +52,8 @@ def test_bad_mission_settings_exit_non_zero_with_one_line(capsys, tmp_path, args
 
 
 def test_resume_refuses_mixed_settings_and_finished_runs(capsys, tmp_path: Path) -> None:
-    from seminspect.missions.config import make_config, resolve
-    from seminspect.missions.rundir import RunDirectory
+    from seminspect.missions.xflie.config import make_config, resolve
+    from seminspect.runs.directory import RunDirectory
 
     config = resolve(make_config({"world": "subterranean"})).model_dump(mode="json")
     with RunDirectory(tmp_path / "run").claimed(config) as stored:

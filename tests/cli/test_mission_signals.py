@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from seminspect.graphs.lsg.io import load_graph
-from seminspect.missions.rundir import LOCK_FILE, read_run_status
+from seminspect.runs.directory import LOCK_FILE, read_run_status
 
 SRC = Path(__file__).resolve().parents[2] / "src"
 

@@ -3,7 +3,7 @@
 import pytest
 
 from cli_runner import run
-from seminspect.learning.evaluation import EvaluationResult
+from seminspect.missions.learning.evaluation import EvaluationResult
 
 
 def test_eval_writes_the_json_the_pictures_and_a_table_beside_table_1(capsys, tmp_path):

@@ -10,7 +10,7 @@ from scipy.spatial.distance import cdist
 
 from seminspect.core.errors import InvalidInputError, PlanningError, UnknownNameError
 from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap
-from seminspect.planning.grid_search import make_query
+from seminspect.planning.grid_astar import make_query
 from seminspect.planning.gridmap import CostModel
 from seminspect.planning.volumetric import ENGINES, RebuildingVolumetricPlanner, VolumetricPlanner
 
@@ -219,7 +219,7 @@ def test_bad_arguments_are_refused() -> None:
 
 def test_plans_across_the_real_geb079_corridor(shared_data) -> None:
     pytest.importorskip("pyoctomap")
-    from seminspect.mapping.octomap_io import load_octomap
+    from seminspect.mapping.formats.octomap import load_octomap
 
     grid_map = load_octomap(shared_data / "octomap" / "geb079.bt", resolution=0.16)
     planner = VolumetricPlanner(grid_map, CostModel(0.25))  # unknown space blocked

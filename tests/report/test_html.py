@@ -15,8 +15,8 @@ from seminspect.graphs.lsg.io import load_graph
 from seminspect.graphs.terrain.io import save_terrain_graph
 from seminspect.graphs.terrain.prompting import TaskPrompts
 from seminspect.graphs.terrain.scene_graph import build_terrain_graph
+from seminspect.mapping.formats.pointfiles import PointData
 from seminspect.mapping.ingest import cloud_from_point_data
-from seminspect.mapping.pointfiles import PointData
 from seminspect.report.html import REPORT_FILE, THUMBNAIL_WIDTH, write_report
 
 CHROMIUM_ARGS = [

@@ -5,10 +5,10 @@ import math
 import numpy as np
 import pytest
 
-from seminspect.learning.baselines import OrbitController, RandomController
-from seminspect.learning.env import EnvConfig
-from seminspect.learning.evaluation import evaluate
-from seminspect.learning.rooms import BOX, CYLINDER, TARGET_FACES
+from seminspect.missions.learning.baselines import OrbitController, RandomController
+from seminspect.missions.learning.env import EnvConfig
+from seminspect.missions.learning.evaluation import evaluate
+from seminspect.missions.learning.rooms import BOX, CYLINDER, TARGET_FACES
 from seminspect.report.rl import (
     coverage_figure,
     face_states,

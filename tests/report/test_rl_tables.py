@@ -6,11 +6,11 @@ from pathlib import Path
 
 import pytest
 
-from seminspect.learning.baselines import OrbitController, RandomController
-from seminspect.learning.env import EnvConfig
-from seminspect.learning.evaluation import PAPER_TABLE3, evaluate
+from seminspect.missions.learning.baselines import OrbitController, RandomController
+from seminspect.missions.learning.env import EnvConfig
+from seminspect.missions.learning.evaluation import PAPER_TABLE3, evaluate
 from seminspect.report.markdown import replace_sections
-from seminspect.report.rl_tables import (
+from seminspect.studies.learning.tables import (
     NEEDS,
     SECTIONS,
     ablation_markdown,

@@ -1,7 +1,7 @@
 import pytest
 
-from seminspect.missions.routine import RoutineConfig
-from seminspect.missions.routine_run import run_routine
+from seminspect.missions.routine.executive import RoutineConfig
+from seminspect.missions.routine.run import run_routine
 from seminspect.report.routine import comparison_figure, load_views, render_routine
 
 

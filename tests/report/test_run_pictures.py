@@ -1,8 +1,8 @@
 import matplotlib.pyplot as plt
 import pytest
 
-from seminspect.missions.rundir import load_trajectory
 from seminspect.report.run_pictures import load_events, render_run, timeline_figure
+from seminspect.runs.directory import load_trajectory
 
 
 @pytest.mark.slow

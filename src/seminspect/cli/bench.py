@@ -69,8 +69,8 @@ def planning(
     """
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from seminspect.studies.planning.study import run_study
-    from seminspect.studies.planning.tables import write_study
+    from seminspect.studies.xflie.study import run_study
+    from seminspect.studies.xflie.tables import write_study
 
     sizes = sorted(set(size)) if scaling else []
     if any(n < 2 for n in sizes):

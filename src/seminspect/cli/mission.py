@@ -99,7 +99,7 @@ def app(
     Ctrl-C and SIGTERM stop the mission and leave a valid run directory (exit codes 130, 143).
     """
     from seminspect.core.errors import InvalidInputError
-    from seminspect.missions.config import make_config
+    from seminspect.missions.xflie.config import make_config
 
     if bag is not None and bag.exists():  # refuse before the mission, not after it
         raise InvalidInputError(f"{bag} exists; choose a new bag name")
@@ -142,8 +142,8 @@ def _world_argument(world: str) -> str:
 def _resumed(ctx: typer.Context, run_dir: Path):
     """The configuration and directory of a run to finish; mission settings may not be mixed in."""
     from seminspect.core.errors import InvalidInputError
-    from seminspect.missions.config import make_config
-    from seminspect.missions.rundir import resumable_config
+    from seminspect.missions.xflie.config import make_config
+    from seminspect.runs.directory import resumable_config
 
     given = [
         f"--{name}"
@@ -176,7 +176,7 @@ def _resumed(ctx: typer.Context, run_dir: Path):
 def _run_with_progress(config, out: Path | None, queries: list[str]):
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from seminspect.missions.run import run_mission
+    from seminspect.missions.xflie.run import run_mission
 
     columns = (
         TextColumn("[bold]{task.description}"),
@@ -206,7 +206,7 @@ def _run_with_progress(config, out: Path | None, queries: list[str]):
 def _export_bag(run_dir: Path, bag: Path) -> None:
     from rich.progress import MofNCompleteColumn, Progress
 
-    from seminspect.missions.replay import export_run_bag
+    from seminspect.missions.xflie.replay import export_run_bag
 
     columns = (*Progress.get_default_columns()[:2], MofNCompleteColumn())
     with Progress(*columns, console=err_console, transient=True) as progress:

@@ -27,7 +27,7 @@ _THREADS = typer.Option(1, "--threads", help="Ray-casting threads.", min=1, max=
 def parse_obstacles(text: str) -> list[int]:
     """``"0,4,9"`` -> ``[0, 4, 9]``: distinct non-negative counts within the rooms' limit."""
     from seminspect.core.errors import InvalidInputError
-    from seminspect.learning.env import EnvConfig
+    from seminspect.missions.learning.env import EnvConfig
 
     limit = EnvConfig.model_fields["obstacles"].metadata
     most = next(m.le for m in limit if hasattr(m, "le"))
@@ -47,7 +47,7 @@ def parse_obstacles(text: str) -> list[int]:
 def controller_for(policy: str | None, seed: int):
     """The baseline named ``policy``, or the learned policy from a checkpoint (None: shipped)."""
     from seminspect.core.errors import InvalidInputError
-    from seminspect.learning.baselines import OrbitController, RandomController
+    from seminspect.missions.learning.baselines import OrbitController, RandomController
 
     if policy == "random":
         return RandomController(seed)
@@ -58,7 +58,7 @@ def controller_for(policy: str | None, seed: int):
             f"unknown policy {policy!r}: use {', '.join(BASELINES)} or a checkpoint file"
         )
     _require_torch()
-    from seminspect.learning.agent import load_controller
+    from seminspect.missions.learning.agent import load_controller
 
     return load_controller(None if policy is None else Path(policy))
 
@@ -94,7 +94,7 @@ def eval_command(
     """Coverage, crash % and timeout % per obstacle count, beside 004 Table I."""
     from seminspect.cli._common import writable_directory
     from seminspect.core.errors import InvalidInputError
-    from seminspect.learning.evaluation import EpisodeTrace, evaluate
+    from seminspect.missions.learning.evaluation import EpisodeTrace, evaluate
     from seminspect.report.figures import save_figure
     from seminspect.report.rl import coverage_figure, write_episode_pictures
 
@@ -139,7 +139,7 @@ def eval_command(
 def _print_table(result) -> None:
     from rich.table import Table
 
-    from seminspect.learning.evaluation import PAPER_TABLE1
+    from seminspect.missions.learning.evaluation import PAPER_TABLE1
 
     table = Table(title=f"{result.policy}: {result.results[0].episodes} episodes per row")
     for header in ("obstacles", "coverage %", "004", "crash %", "004", "timeout %", "004"):
@@ -163,8 +163,8 @@ def show_command(
 ) -> None:
     """Fly one recorded episode and draw it (top-down, 3D, coverage against time)."""
     from seminspect.cli._common import writable_directory
-    from seminspect.learning.env import EnvConfig, InspectionVectorEnv
-    from seminspect.learning.evaluation import EpisodeTrace
+    from seminspect.missions.learning.env import EnvConfig, InspectionVectorEnv
+    from seminspect.missions.learning.evaluation import EpisodeTrace
     from seminspect.report.rl import write_episode_pictures
 
     writable_directory(out)
@@ -207,9 +207,13 @@ def train_command(
     """Train a policy with recurrent PPO and the obstacle curriculum; Ctrl-C keeps a checkpoint."""
     from seminspect.cli._common import writable_directory
     from seminspect.core.errors import InvalidInputError
-    from seminspect.learning.env import InspectionVectorEnv
-    from seminspect.learning.ppo import ProgressRow, train
-    from seminspect.learning.recipes import policy_config, train_config, training_env_config
+    from seminspect.missions.learning.env import InspectionVectorEnv
+    from seminspect.missions.learning.ppo import ProgressRow, train
+    from seminspect.missions.learning.recipes import (
+        policy_config,
+        train_config,
+        training_env_config,
+    )
 
     if steps < 1:
         raise InvalidInputError(f"--steps must be at least 1, got {steps}")

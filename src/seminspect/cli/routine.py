@@ -30,7 +30,7 @@ _CURRENT = typer.Option(
 def _config_and_site(world, scenario, seed, length, historical, current, *, need_current=True):
     """The settings, and the user's site pair when --historical/--current are given."""
     from seminspect.core.errors import InvalidInputError
-    from seminspect.missions.routine import RoutineConfig
+    from seminspect.missions.routine.executive import RoutineConfig
     from seminspect.worlds.routine_sites import user_site, world_files
 
     if historical is None and current is None:
@@ -52,7 +52,7 @@ def map_command(
     out: Path = typer.Option(..., "--out", "-o", help="Directory for the map (map.npz)."),
 ) -> None:
     """Record M_H: a mapping traverse through the scenario's historical world."""
-    from seminspect.missions.routine_run import map_site
+    from seminspect.missions.routine.run import map_site
 
     config, site = _config_and_site(
         world, scenario, seed, length, historical, None, need_current=False
@@ -88,7 +88,7 @@ def inspect_command(
     pictures: bool = typer.Option(True, "--pictures/--no-pictures", help="Draw the pictures."),
 ) -> None:
     """Inspect the scenario's regions in the current world with a plan made on M_H."""
-    from seminspect.missions.routine_run import PRIOR_FILE, run_routine
+    from seminspect.missions.routine.run import PRIOR_FILE, run_routine
     from seminspect.report.figures import save_figure
     from seminspect.report.routine import comparison_figure, render_routine
 

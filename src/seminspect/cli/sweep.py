@@ -71,7 +71,13 @@ def app(
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
     from seminspect.core.errors import InvalidInputError
-    from seminspect.missions.sweep import SweepSpec, expand, load_spec, run_on_ray, sweep_tables
+    from seminspect.missions.xflie.sweep import (
+        SweepSpec,
+        expand,
+        load_spec,
+        run_on_ray,
+        sweep_tables,
+    )
 
     if grid is not None:
         if world or scenario or setting:

@@ -38,15 +38,15 @@ def _param_overrides(items: list[str], cell_size: float | None) -> dict[str, Any
 def _load_cloud(inputs: list[Path], labels: list[Path], options: dict[str, Any], encoder, progress):
     """The phase-1 cloud, and fused KITTI labels when the input is scans (else ``None``)."""
     from seminspect.core.errors import InvalidInputError
-    from seminspect.mapping.ingest import cloud_from_point_data
-    from seminspect.mapping.pointfiles import label_names_from_text, load_point_file
-    from seminspect.mapping.semantic_cloud import cloud_from_arrays, is_cloud_file, read_npz
-    from seminspect.mapping.semantickitti import (
+    from seminspect.mapping.formats.pointfiles import label_names_from_text, load_point_file
+    from seminspect.mapping.formats.semantickitti import (
         fuse_kitti_scans,
         read_calib,
         read_poses,
         velodyne_poses,
     )
+    from seminspect.mapping.ingest import cloud_from_point_data
+    from seminspect.mapping.semantic_cloud import cloud_from_arrays, is_cloud_file, read_npz
 
     if all(path.suffix.lower() == ".bin" for path in inputs):
         if len(labels) != len(inputs):
@@ -111,7 +111,7 @@ def _kitti_quality(build, fused, encoder) -> dict[str, Any]:
     reported unscored rather than scored against the nearest thing.
     """
     from seminspect.graphs.terrain.evaluate import match_boxes, match_class, predicted_boxes
-    from seminspect.mapping.semantickitti import instance_boxes, label_table
+    from seminspect.mapping.formats.semantickitti import instance_boxes, label_table
 
     table = label_table()
     things = table.thing_classes()
@@ -140,7 +140,7 @@ def _kitti_quality(build, fused, encoder) -> dict[str, Any]:
 
 def _quality(build, cloud, fused, encoder) -> dict[str, Any]:
     """Scores against the scans' instance labels, or against the simulated world's truth."""
-    from seminspect.missions.terrain_mapping import evaluate_on_world, source_world
+    from seminspect.missions.terrain.mapping import evaluate_on_world, source_world
 
     if fused is not None:
         return _kitti_quality(build, fused, encoder)
@@ -329,7 +329,7 @@ def map_command(
     from rich.progress import MofNCompleteColumn, Progress, TimeElapsedColumn
 
     from seminspect.mapping.semantic_cloud import save_cloud
-    from seminspect.missions.terrain_mapping import make_mapping_params, map_world
+    from seminspect.missions.terrain.mapping import make_mapping_params, map_world
     from seminspect.worlds import open_world
 
     writable_file(out, (".npz",))
@@ -366,10 +366,10 @@ def _map_bag(bag: Path, topics: tuple[str, str, str, str | None], out: Path, enc
     """001's metric-semantic cloud from a bag's labelled clouds, one view per cloud."""
     from rich.progress import Progress, TimeElapsedColumn
 
-    from seminspect.mapping.pointfiles import label_names_from_text
-    from seminspect.mapping.rosbag import fuse_bag, read_bag_scans, read_label_names
+    from seminspect.mapping.formats.pointfiles import label_names_from_text
+    from seminspect.mapping.formats.rosbag import fuse_bag, read_bag_scans, read_label_names
+    from seminspect.mapping.formats.semantickitti import label_table
     from seminspect.mapping.semantic_cloud import save_cloud
-    from seminspect.mapping.semantickitti import label_table
 
     cloud_topic, odom_topic, labels_field, names_text = topics
     names = label_names_from_text(names_text) if names_text else read_label_names(bag)

@@ -15,7 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from seminspect.core.errors import InvalidInputError
 from seminspect.geometry.transforms import as_points
-from seminspect.mapping.pointfiles import PointData
+from seminspect.mapping.formats.pointfiles import PointData
 from seminspect.mapping.semantic_cloud import (
     IntegrationStats,
     SemanticCloud,

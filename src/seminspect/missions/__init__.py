@@ -1,28 +1,11 @@
-"""Missions: the xFLIE explore-inspect-explore executive, the frontier explorer, run directories."""
+"""The programs, one subpackage per paper: :mod:`.xflie` (000), :mod:`.terrain` (001),
+:mod:`.routine` (002) and :mod:`.learning` (004).
 
-from seminspect.missions.config import MissionConfig, ResolvedMissionConfig, make_config, resolve
-from seminspect.missions.frontier_mission import FrontierMission
-from seminspect.missions.metrics import MissionMetrics
-from seminspect.missions.platform import Platform, SimulatedPlatform
-from seminspect.missions.recorder import MissionRecorder
-from seminspect.missions.run import MissionResult, run_mission
-from seminspect.missions.rundir import RunDirectory
-from seminspect.missions.terrain_mapping import map_world
+The names of the default program, the xFLIE mission, are re-exported here.
+"""
+
 from seminspect.missions.xflie import XFlie
+from seminspect.missions.xflie.config import MissionConfig, make_config
+from seminspect.missions.xflie.run import MissionResult, run_mission
 
-__all__ = [
-    "FrontierMission",
-    "MissionConfig",
-    "MissionMetrics",
-    "MissionRecorder",
-    "MissionResult",
-    "Platform",
-    "ResolvedMissionConfig",
-    "RunDirectory",
-    "SimulatedPlatform",
-    "XFlie",
-    "make_config",
-    "map_world",
-    "resolve",
-    "run_mission",
-]
+__all__ = ["MissionConfig", "MissionResult", "XFlie", "make_config", "run_mission"]

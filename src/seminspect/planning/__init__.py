@@ -2,12 +2,12 @@
 frontier exploration."""
 
 from seminspect.planning.frontier import FrontierPlanner
-from seminspect.planning.grid_search import GridPath
+from seminspect.planning.grid_astar import GridPath
 from seminspect.planning.gridmap import CostGrid, CostModel
 from seminspect.planning.hierarchical import HierarchicalPlanner, RoutePlan
-from seminspect.planning.local import LocalPlanner
 from seminspect.planning.ompl_planner import OmplPlanner
 from seminspect.planning.query import parse_query
+from seminspect.planning.routes import LocalPlanner
 from seminspect.planning.smoothing import refine_path
 from seminspect.planning.utility import UtilityTerms, select_target
 from seminspect.planning.view_planner import ViewConstraints, next_view_pose

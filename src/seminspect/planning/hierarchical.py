@@ -42,7 +42,7 @@ from seminspect.graphs.lsg.model import (
     TargetNode,
     TargetStatus,
 )
-from seminspect.planning.graph_search import CsrGraph, shortest_path, warm_up
+from seminspect.planning.graph_astar import CsrGraph, shortest_path, warm_up
 from seminspect.planning.query import Query, Verb, parse_query, resolve_query
 
 

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from seminspect.core.errors import InvalidInputError, PlanningError, SeminspectError
 from seminspect.core.rng import make_rng
 from seminspect.mapping.voxel import VoxelMap
-from seminspect.planning.grid_search import GridPath, make_query
+from seminspect.planning.grid_astar import GridPath, make_query
 from seminspect.planning.gridmap import CostGrid, CostModel, format_point
 from seminspect.planning.smoothing import path_length
 

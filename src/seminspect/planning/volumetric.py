@@ -12,7 +12,7 @@ what runs here.
 Four engines answer the same query on the same costs and give the same optimal cost; they exist
 so ``bench/grid_planning.py`` can compare them:
 
-- ``astar``: the compiled A* of :mod:`~seminspect.planning.grid_search` (the default, fastest);
+- ``astar``: the compiled A* of :mod:`~seminspect.planning.grid_astar` (the default, fastest);
 - ``dijkstra``: the same kernel without its heuristic;
 - ``mcp``: scikit-image's ``MCP_Geometric`` (Cython Dijkstra, stops at the first goal);
 - ``csgraph``: scipy's ``csgraph.dijkstra`` on a sparse graph of the grid (full single-source).
@@ -32,7 +32,7 @@ from skimage.graph import MCP_Geometric
 
 from seminspect.core.names import unknown_name
 from seminspect.mapping.voxel import VoxelMap
-from seminspect.planning.grid_search import (
+from seminspect.planning.grid_astar import (
     GridPath,
     Query,
     make_path,
@@ -162,7 +162,7 @@ class RebuildingVolumetricPlanner:
     and takes straight shortcuts on the same grid, as the paper's D*+ smooths its route with a
     spline. ``planning_time`` counts the grid build, the search and the shortcuts; coarsening
     stands in for the baseline's own map, which it would maintain anyway, and is not counted.
-    It answers the mission's navigator like :class:`~seminspect.planning.local.LocalPlanner`.
+    It answers the mission's navigator like :class:`~seminspect.planning.routes.LocalPlanner`.
     """
 
     def __init__(

@@ -25,9 +25,9 @@ from matplotlib.patches import Circle, Patch, Polygon, Rectangle, Wedge
 from numpy.typing import NDArray
 from scipy.spatial import ConvexHull
 
-from seminspect.learning.env import EnvConfig
-from seminspect.learning.evaluation import EpisodeTrace, EvaluationResult
-from seminspect.learning.rooms import BOX, CYLINDER, TARGET_BANDS, TARGET_SECTORS, Room
+from seminspect.missions.learning.env import EnvConfig
+from seminspect.missions.learning.evaluation import EpisodeTrace, EvaluationResult
+from seminspect.missions.learning.rooms import BOX, CYLINDER, TARGET_BANDS, TARGET_SECTORS, Room
 from seminspect.report.figures import new_figure, save_figure
 
 COVERED, FAR, UNSEEN = "tab:green", "tab:orange", "tab:red"

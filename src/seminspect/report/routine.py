@@ -18,10 +18,10 @@ from matplotlib.figure import Figure
 
 from seminspect.core.io import read_versioned_json
 from seminspect.mapping.voxel import OCCUPIED, load_map
-from seminspect.missions.routine_measures import change_masks
-from seminspect.missions.routine_run import PRIOR_FILE, TOUR_FORMAT
-from seminspect.missions.rundir import load_trajectory, read_run_config
+from seminspect.missions.routine.measures import change_masks
+from seminspect.missions.routine.run import PRIOR_FILE, TOUR_FORMAT
 from seminspect.report.figures import new_figure, save_figure
+from seminspect.runs.directory import load_trajectory, read_run_config
 
 #: Heights drawn as M_H's walls in the change picture [m].
 WALL_BAND_M = (0.3, 4.0)

@@ -4,6 +4,6 @@ Each study is one subpackage holding everything it needs: the paper's rows, the 
 or reuses, how it chooses its queries, its records, and the tables and plots it writes.
 """
 
-from seminspect.studies import planning
+from seminspect.studies import xflie
 
-__all__ = ["planning"]
+__all__ = ["xflie"]

@@ -1,7 +1,7 @@
 import pytest
 
 from seminspect.graphs.terrain.evaluate import match_class, prompt_name
-from seminspect.mapping.semantickitti import label_table
+from seminspect.mapping.formats.semantickitti import label_table
 
 KITTI = sorted(set(label_table().names.values()))
 

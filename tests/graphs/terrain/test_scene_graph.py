@@ -17,8 +17,8 @@ from seminspect.graphs.terrain.navigation import nearest_place, shortest_route
 from seminspect.graphs.terrain.params import make_terrain_params
 from seminspect.graphs.terrain.prompting import TaskPrompts
 from seminspect.graphs.terrain.scene_graph import build_terrain_graph
+from seminspect.mapping.formats.pointfiles import PointData
 from seminspect.mapping.ingest import cloud_from_point_data
-from seminspect.mapping.pointfiles import PointData
 
 PROMPTS = TaskPrompts.parse("sidewalk,grass,asphalt", "image of a tree,image of a car")
 

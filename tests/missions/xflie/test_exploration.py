@@ -4,7 +4,7 @@ import numpy as np
 
 from fake_platform import FakePlatform, fake_context, headings_apart
 from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN
-from seminspect.missions.config import survey_headings
+from seminspect.missions.xflie.config import survey_headings
 from seminspect.missions.xflie.exploration import FRONTIER_MIN_DISTANCE, Exploration
 
 

@@ -23,16 +23,16 @@ from numpy.typing import NDArray
 from seminspect.core.errors import PlanningError
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.model import TargetNode, TargetStatus
-from seminspect.missions.config import ResolvedMissionConfig
-from seminspect.missions.navigation import RoutePlanner
-from seminspect.missions.platform import heading_to
+from seminspect.missions.xflie.config import ResolvedMissionConfig
 from seminspect.missions.xflie.context import MissionContext
+from seminspect.missions.xflie.navigation import RoutePlanner
 from seminspect.missions.xflie.sightings import register_targets, target_view
 from seminspect.planning.gridmap import CostModel
 from seminspect.planning.hierarchical import HierarchicalPlanner
-from seminspect.planning.local import LocalPlanner
+from seminspect.planning.routes import LocalPlanner
 from seminspect.planning.smoothing import refine_path
 from seminspect.planning.volumetric import RebuildingVolumetricPlanner
+from seminspect.platform.protocol import heading_to
 
 #: Extra clearance added to the robot radius in the planners' inflation [m].
 PLANNING_MARGIN = 0.2

@@ -14,7 +14,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from seminspect.missions.platform import heading_to
 from seminspect.missions.xflie.context import MissionContext
 from seminspect.perception.similarity import (
     ORB_GAMMA_THRESHOLD,
@@ -22,6 +21,7 @@ from seminspect.perception.similarity import (
     SceneMatcher,
     scene_similarity,
 )
+from seminspect.platform.protocol import heading_to
 from seminspect.sensors import Frame
 
 #: A level also ends (as a safety cap) once the robot has circled the target this far [rad].

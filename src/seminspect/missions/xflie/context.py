@@ -9,13 +9,13 @@ from seminspect.core.params import InspectionParams
 from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.mapping.voxel import VoxelMap
-from seminspect.missions.config import ResolvedMissionConfig
-from seminspect.missions.metrics import Timers
-from seminspect.missions.navigation import Navigator
-from seminspect.missions.platform import Platform
-from seminspect.missions.recorder import MissionRecorder
-from seminspect.missions.rundir import RunDirectory
+from seminspect.missions.xflie.config import ResolvedMissionConfig
+from seminspect.missions.xflie.metrics import Timers
+from seminspect.missions.xflie.navigation import Navigator
+from seminspect.missions.xflie.recorder import MissionRecorder
 from seminspect.perception.observation import Observation
+from seminspect.platform.protocol import Platform
+from seminspect.runs.directory import RunDirectory
 from seminspect.sensors import Detection, Frame
 
 #: Every DEPTH_STRIDE-th pixel (rows and columns) of a depth frame goes into the map.

@@ -29,21 +29,21 @@ from numpy.typing import NDArray
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.model import TargetNode
 from seminspect.mapping.voxel import VoxelMap
-from seminspect.missions.config import ResolvedMissionConfig
-from seminspect.missions.metrics import CoverageRecorder
-from seminspect.missions.navigation import Navigator
-from seminspect.missions.platform import Platform
-from seminspect.missions.recorder import MissionRecorder
-from seminspect.missions.rundir import RunDirectory
 from seminspect.missions.xflie.approach import Approach, baseline_planner, local_planner
+from seminspect.missions.xflie.config import ResolvedMissionConfig
 from seminspect.missions.xflie.context import MissionContext
 from seminspect.missions.xflie.exploration import Exploration
 from seminspect.missions.xflie.inspection import LevelInspection, platform_vfov
 from seminspect.missions.xflie.links import TargetLinks
+from seminspect.missions.xflie.metrics import CoverageRecorder
+from seminspect.missions.xflie.navigation import Navigator
+from seminspect.missions.xflie.recorder import MissionRecorder
 from seminspect.missions.xflie.sightings import register_targets
 from seminspect.planning.hierarchical import HierarchicalPlanner
 from seminspect.planning.utility import UtilityTerms, select_target
 from seminspect.planning.view_planner import ViewConstraints
+from seminspect.platform.protocol import Platform
+from seminspect.runs.directory import RunDirectory
 from seminspect.sensors import Frame
 
 #: No new target is started with less simulated time left than this [s].

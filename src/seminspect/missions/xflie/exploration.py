@@ -16,8 +16,8 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from seminspect.missions.config import survey_headings
 from seminspect.missions.xflie.approach import level_flight_planner
+from seminspect.missions.xflie.config import survey_headings
 from seminspect.missions.xflie.context import MissionContext
 from seminspect.missions.xflie.sightings import register_targets
 from seminspect.planning.frontier import find_frontiers

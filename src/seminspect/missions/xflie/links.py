@@ -19,9 +19,9 @@ from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.model import TargetNode, TargetStatus
 from seminspect.mapping.voxel import VoxelMap
 from seminspect.missions.xflie.context import MissionContext
-from seminspect.planning.grid_search import GridPath
+from seminspect.planning.grid_astar import GridPath
 from seminspect.planning.gridmap import CostModel
-from seminspect.planning.local import LocalPlanner
+from seminspect.planning.routes import LocalPlanner
 
 #: A new target is linked to at most this many inspected targets, nearest first.
 NEIGHBOURS = 3

@@ -3,8 +3,8 @@ in what each prefers.
 
 Beyond 000, after its Sec IX (heterogeneous robots sharing one graph). Each robot is a whole
 :class:`XFlie` (its own platform, navigator, trajectory and clock) built on the same
-:class:`LayeredSemanticGraph` (and, as :mod:`seminspect.missions.team_run` builds them, the same
-occupancy map); the team only decides which phase each one runs next.
+:class:`LayeredSemanticGraph` (and, as :mod:`seminspect.missions.xflie.team_run` builds them,
+the same occupancy map); the team only decides which phase each one runs next.
 
 * The **explorer** prefers exploring: ``π^expl:360`` where it starts, then frontier hops with a
   survey at each (the mission's own nearest-frontier rule, unrestricted), until no frontier is

@@ -1,0 +1,55 @@
+"""Learned inspection: the semantic deep-RL planner of paper 004.
+
+The rooms and vector environment, baselines and evaluation need only numpy and gymnasium. The
+policy network (``learning.policy``: 004 Sec III-D, Fig 2) and its recurrent PPO trainer
+(``learning.ppo``) need torch (the ``rl`` extra); those names are imported on first use, so
+importing the package, or its environment, does not load torch.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+from seminspect.missions.learning.baselines import Controller, OrbitController, RandomController
+from seminspect.missions.learning.env import EnvConfig, InspectionEnv, InspectionVectorEnv
+from seminspect.missions.learning.evaluation import EpisodeTrace, EvaluationResult, evaluate
+from seminspect.missions.learning.rooms import Room, sample_room
+
+#: Public name -> the module that defines it (imported lazily: torch is an optional extra).
+_LAZY = {
+    "InspectionPolicy": "seminspect.missions.learning.policy",
+    "PolicyConfig": "seminspect.missions.learning.policy",
+    "load_policy": "seminspect.missions.learning.ppo",
+    "train": "seminspect.missions.learning.ppo",
+    "TrainConfig": "seminspect.missions.learning.ppo",
+    "LearnedController": "seminspect.missions.learning.agent",
+    "load_controller": "seminspect.missions.learning.agent",
+}
+
+__all__ = [
+    "Controller",
+    "EnvConfig",
+    "EpisodeTrace",
+    "EvaluationResult",
+    "InspectionEnv",
+    "InspectionPolicy",
+    "InspectionVectorEnv",
+    "LearnedController",
+    "OrbitController",
+    "PolicyConfig",
+    "RandomController",
+    "Room",
+    "TrainConfig",
+    "evaluate",
+    "load_controller",
+    "load_policy",
+    "sample_room",
+    "train",
+]
+
+
+def __getattr__(name: str) -> Any:
+    if name not in _LAZY:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return getattr(importlib.import_module(_LAZY[name]), name)

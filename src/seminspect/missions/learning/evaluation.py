@@ -1,0 +1,293 @@
+"""The evaluation protocol of 004 Sec IV-A: coverage, crashes and timeouts per obstacle count.
+
+For each obstacle count K, exactly ``episodes`` rooms are run to the end of their episode
+(batches of at most ``num_envs`` rooms stepped together without autoreset, so each room runs
+one episode and then freezes). A crash is contact with anything; a timeout is an episode that
+stayed collision-free to its end (Sec IV-A), so crash % + timeout % = 100 %. The coverage of an
+episode is the fraction of the target's N_f faces seen within ``inspect_range`` when it ends.
+
+Each batch is reset with a seed derived from ``seed``, K and the batch index, so two controllers
+evaluated with the same ``seed`` and ``num_envs`` meet the same rooms; the rooms' fingerprints
+are kept to show it.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import BaseModel, ConfigDict, ValidationError
+
+from seminspect.core.errors import FileFormatError, InvalidInputError
+from seminspect.core.io import read_versioned_json, write_versioned_json
+from seminspect.core.rng import make_rng
+from seminspect.core.validation import build, describe_validation_error
+from seminspect.missions.learning.baselines import Controller
+from seminspect.missions.learning.env import EnvConfig, InspectionVectorEnv
+from seminspect.missions.learning.rooms import Room
+
+FORMAT = "seminspect.rl-evaluation"
+VERSION = 1
+#: 004 Table I (the trained policy): obstacles -> (coverage %, crash %, timeout %).
+PAPER_TABLE1: dict[int, tuple[float, float, float]] = {
+    0: (92.1, 0.0, 100.0),
+    4: (82.6, 0.3, 99.7),
+    9: (74.6, 1.2, 98.8),
+    14: (64.2, 1.5, 98.5),
+    19: (58.1, 1.3, 98.7),
+}
+#: 004 Table II (9 obstacles): coverage %, crash %, timeout % without and with the SVS map.
+PAPER_TABLE2: dict[str, tuple[float, float, float]] = {
+    "m^o": (52.3, 1.0, 99.0),
+    "m^o & m^h": (74.6, 1.2, 98.8),
+}
+#: 004 Table III (9 obstacles): the same without a GRU and with GRUs of 128 and 512 units.
+PAPER_TABLE3: dict[str, tuple[float, float, float]] = {
+    "no GRU": (59.8, 3.6, 96.4),
+    "GRU 128": (63.6, 1.1, 99.1),
+    "GRU 512": (74.6, 1.2, 98.8),
+}
+#: Coverage curves are kept at this interval (s), and in full for this many episodes per K.
+CURVE_INTERVAL = 1.0
+KEPT_CURVES = 4
+
+Progress = Callable[[str, float], None]
+
+
+class ObstacleResult(BaseModel):
+    """Outcome of every episode at one obstacle count (percentages in 0-100)."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    obstacles: int
+    episodes: int
+    coverage_pct: float
+    crash_pct: float
+    timeout_pct: float
+    #: Per episode: final coverage %, crashed or not, steps flown, room fingerprint.
+    coverage: list[float]
+    crashed: list[bool]
+    length: list[int]
+    rooms: list[str]
+    #: Coverage % against ``curve_times``: mean, 5th and 95th percentile over the episodes,
+    #: and the curves of the first ``KEPT_CURVES`` episodes.
+    curve_times: list[float]
+    curve_mean: list[float]
+    curve_p5: list[float]
+    curve_p95: list[float]
+    curves: list[list[float]]
+
+
+class EvaluationResult(BaseModel):
+    """One controller evaluated at several obstacle counts."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    policy: str
+    seed: int
+    num_envs: int
+    #: The environment's settings; each row replaces ``obstacles`` with its own count.
+    config: EnvConfig
+    wall_seconds: float
+    results: list[ObstacleResult]
+
+    def at(self, obstacles: int) -> ObstacleResult:
+        """The result for one obstacle count."""
+        for result in self.results:
+            if result.obstacles == obstacles:
+                return result
+        raise InvalidInputError(f"no result for {obstacles} obstacles in this evaluation")
+
+    def to_json(self, path: str | os.PathLike[str]) -> Path:
+        """Write atomically as a versioned JSON document."""
+        return write_versioned_json(path, FORMAT, VERSION, self.model_dump(mode="json"), indent=1)
+
+    @classmethod
+    def from_json(cls, path: str | os.PathLike[str]) -> EvaluationResult:
+        document = read_versioned_json(path, FORMAT, [VERSION])
+        payload = {k: v for k, v in document.items() if k not in {"format", "version"}}
+        try:
+            return cls.model_validate(payload)
+        except ValidationError as exc:
+            problem = describe_validation_error(exc, "evaluation")
+            raise FileFormatError(f"{path}: {problem}") from None
+
+
+@dataclass(frozen=True)
+class EpisodeTrace:
+    """What the pictures of one episode need: its room, track and face distances d_f.
+
+    ``track`` rows are (x, y, z, yaw, coverage) from the reset on (see ``env.track``).
+    """
+
+    room: Room
+    track: NDArray[np.float64]
+    face_distances: NDArray[np.float64]
+    crashed: bool
+
+
+@dataclass
+class _Tally:
+    """Per-episode outcomes of one obstacle count, filled batch by batch."""
+
+    coverage: list[float] = field(default_factory=list)
+    crashed: list[bool] = field(default_factory=list)
+    timed_out: list[bool] = field(default_factory=list)
+    length: list[int] = field(default_factory=list)
+    rooms: list[str] = field(default_factory=list)
+    curves: list[NDArray[np.float64]] = field(default_factory=list)
+
+
+def room_fingerprint(room: Room) -> str:
+    """A short digest of a room's geometry and start: equal rooms, equal fingerprints."""
+    digest = hashlib.blake2b(digest_size=6)
+    for array in (room.vertices, room.triangles, room.start):
+        digest.update(np.ascontiguousarray(array).tobytes())
+    return digest.hexdigest()
+
+
+def batch_seed(seed: int, obstacles: int, batch: int) -> int:
+    """The reset seed of one batch of rooms."""
+    rng = make_rng(seed, "learning", "evaluation", f"obstacles-{obstacles}", f"batch-{batch}")
+    return int(rng.integers(2**31))
+
+
+def evaluate(
+    controller: Controller,
+    obstacle_counts: Sequence[int],
+    episodes: int,
+    seed: int,
+    *,
+    config: EnvConfig | None = None,
+    num_envs: int = 64,
+    progress: Progress | None = None,
+    policy: str = "",
+    threads: int = 1,
+    traces: dict[int, EpisodeTrace] | None = None,
+) -> EvaluationResult:
+    """Run ``episodes`` rooms per obstacle count with ``controller`` (004 Sec IV-A).
+
+    Args:
+        controller: drives every batch (``reset`` after each environment reset).
+        obstacle_counts: the K of each row (Table I: 0, 4, 9, 14, 19).
+        episodes: rooms per obstacle count.
+        seed: the rooms (and the environments' noise) follow from it.
+        config: environment settings; its ``obstacles`` is replaced by each K.
+        num_envs: rooms stepped together.
+        progress: called with a label and the share of all steps done.
+        policy: the controller's name, kept in the result.
+        threads: ray-casting threads of the environment.
+        traces: if given, receives the first episode of each K for pictures.
+    """
+    counts = _checked_counts(obstacle_counts)
+    if episodes < 1:
+        raise InvalidInputError(f"episodes must be >= 1, got {episodes}")
+    if num_envs < 1:
+        raise InvalidInputError(f"num_envs must be >= 1, got {num_envs}")
+    base = config or EnvConfig()
+    steps = base.steps_per_episode
+    total = len(counts) * episodes * steps
+    done = 0
+    started = time.perf_counter()
+    results = []
+    for obstacles in counts:
+        cfg = build(EnvConfig, {**base.model_dump(), "obstacles": obstacles}, "environment")
+        tally = _Tally()
+        for batch, first in enumerate(range(0, episodes, num_envs)):
+            size = min(num_envs, episodes - first)
+            record = traces is not None and batch == 0
+            env = InspectionVectorEnv(size, cfg, autoreset=False, record=record, threads=threads)
+
+            def advance(step: int, size=size, obstacles=obstacles, done=done) -> None:
+                if progress is not None:
+                    share = (done + step * size) / total
+                    progress(f"{obstacles} obstacles", share)
+
+            _run_batch(env, controller, batch_seed(seed, obstacles, batch), tally, advance)
+            done += size * steps
+            if record and traces is not None:
+                traces[obstacles] = EpisodeTrace(
+                    env.rooms[0], env.track(0), env.face_distances(0), tally.crashed[first]
+                )
+        results.append(_summarise(obstacles, tally, cfg))
+    return EvaluationResult(
+        policy=policy,
+        seed=seed,
+        num_envs=num_envs,
+        config=base,
+        wall_seconds=time.perf_counter() - started,
+        results=results,
+    )
+
+
+def _checked_counts(obstacle_counts: Sequence[int]) -> list[int]:
+    counts = [int(k) for k in obstacle_counts]
+    if not counts:
+        raise InvalidInputError("give at least one obstacle count")
+    if any(k < 0 for k in counts):
+        raise InvalidInputError(f"obstacle counts must be >= 0, got {counts}")
+    if len(set(counts)) != len(counts):
+        raise InvalidInputError(f"obstacle counts repeat: {counts}")
+    return counts
+
+
+def _run_batch(
+    env: InspectionVectorEnv,
+    controller: Controller,
+    reset_seed: int,
+    tally: _Tally,
+    advance: Callable[[int], None],
+) -> None:
+    """One episode in every room of ``env``; outcomes appended to ``tally``."""
+    cfg = env.config
+    steps = cfg.steps_per_episode
+    every = max(1, round(CURVE_INTERVAL * cfg.control_hz))
+    obs, _ = env.reset(seed=reset_seed)
+    controller.reset(env)
+    fingerprints = [room_fingerprint(room) for room in env.rooms]
+    crashed = np.zeros(env.num_envs, dtype=bool)
+    timed_out = np.zeros(env.num_envs, dtype=bool)
+    length = np.full(env.num_envs, steps)
+    curve = [env.coverage()]
+    for step in range(1, steps + 1):
+        if not (crashed | timed_out).all():  # finished rooms are frozen: nothing left to step
+            obs, _, crash, timeout, _ = env.step(controller.act(env, obs))
+            length[crash] = step
+            crashed |= crash
+            timed_out |= timeout
+        if step % every == 0:
+            curve.append(env.coverage())
+            advance(step)
+    tally.coverage += (100.0 * env.coverage()).tolist()
+    tally.crashed += crashed.tolist()
+    tally.timed_out += timed_out.tolist()
+    tally.length += length.tolist()
+    tally.rooms += fingerprints
+    tally.curves += list(100.0 * np.array(curve).T)
+
+
+def _summarise(obstacles: int, tally: _Tally, config: EnvConfig) -> ObstacleResult:
+    curves = np.array(tally.curves)
+    interval = max(1, round(CURVE_INTERVAL * config.control_hz)) / config.control_hz
+    return ObstacleResult(
+        obstacles=obstacles,
+        episodes=len(tally.coverage),
+        coverage_pct=float(np.mean(tally.coverage)),
+        crash_pct=100.0 * float(np.mean(tally.crashed)),
+        timeout_pct=100.0 * float(np.mean(tally.timed_out)),
+        coverage=tally.coverage,
+        crashed=tally.crashed,
+        length=tally.length,
+        rooms=tally.rooms,
+        curve_times=[round(i * interval, 6) for i in range(curves.shape[1])],
+        curve_mean=curves.mean(axis=0).tolist(),
+        curve_p5=np.percentile(curves, 5, axis=0).tolist(),
+        curve_p95=np.percentile(curves, 95, axis=0).tolist(),
+        curves=curves[:KEPT_CURVES].tolist(),
+    )

@@ -1,0 +1,1 @@
+"""Routine inspection on an outdated map (paper 002)."""

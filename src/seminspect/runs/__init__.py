@@ -1,0 +1,1 @@
+"""Run directories: one locked writer, a heartbeat, a truthful last status, reuse and sweeps."""

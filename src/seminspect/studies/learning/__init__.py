@@ -1,0 +1,1 @@
+"""The learned-inspection study (paper 004 Tables I-III)."""
