@@ -1,6 +1,7 @@
 # Entry points for a fresh machine; each builds the virtual environment it needs.
 #   make mission     install seminspect, compile its kernels, run the default inspection mission
 #   make test        install seminspect with test tools and run the test suite
+#   make docs        build the API reference from the docstrings into build/docs
 #   make reproduce   regenerate every measured table of docs/reproduction.md (45 minutes on 2 cores)
 #   make lock        rewrite requirements.lock from the versions installed in .venv
 # Installs take the exact versions of requirements.lock (the ones behind the published
@@ -10,7 +11,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 LOCK := requirements.lock
 
-.PHONY: mission test lint bench reproduce lock clean
+.PHONY: mission test lint docs bench reproduce lock clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -46,6 +47,11 @@ lint: $(VENV)/.installed-test
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
 
+# Into build/docs (mkdocs.yml), pages generated from the package tree (docs/hooks/); any
+# warning fails the build.
+docs: $(VENV)/.installed-test
+	$(BIN)/mkdocs build --strict
+
 reproduce: $(VENV)/.installed-test
 	$(BIN)/python bench/reproduction.py --fresh
 
@@ -56,4 +62,4 @@ lock: | $(BIN)/python
 	touch $(VENV)/.installed-test $(VENV)/.installed-run
 
 clean:
-	rm -rf $(VENV) runs .pytest_cache .ruff_cache
+	rm -rf $(VENV) runs build .pytest_cache .ruff_cache

@@ -10,7 +10,7 @@ behaviour to allow); the continuous figures are widened by ``WIDENING`` (10 %) o
 the outcome figures (counts of targets, levels, detections, false targets, collisions) are not
 widened at all.
 
-``tests/missions/test_golden.py`` holds the golden mission to it on every machine, beside the
+``tests/missions/xflie/test_golden.py`` holds the golden mission to it on every machine, beside the
 exact figures where the machine matches a golden file; ``bench/reproduction.py --only
 golden-envelope`` records the seeds' figures from its city small runs into ``ENVELOPE``.
 
@@ -39,7 +39,8 @@ from typing import Any
 from seminspect.core.io import atomic_write_text
 
 ENVELOPE = (
-    Path(__file__).resolve().parents[1] / "tests/missions/data/golden/city-small-envelope.json"
+    Path(__file__).resolve().parents[1]
+    / "tests/missions/xflie/data/golden/city-small-envelope.json"
 )
 FORMAT = "seminspect.golden-envelope"
 #: How far each bound of a continuous figure is widened, as a share of the bound.

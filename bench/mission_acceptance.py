@@ -23,8 +23,8 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from seminspect.missions.xflie.config import make_config, resolve
+from seminspect.missions.xflie.layout import read_metrics_document, reusable_mission
 from seminspect.missions.xflie.run import run_mission
-from seminspect.runs.directory import read_metrics_document, reusable_run
 
 CITY = [("city", scenario, seed) for scenario in ("small", "medium", "large") for seed in (0, 1, 2)]
 OTHERS = [
@@ -83,7 +83,7 @@ def run_acceptance(
     for world, scenario, seed in runs:
         config = resolve(make_config({"world": world, "scenario": scenario, "seed": seed}))
         out = out_dir / f"{world}-{scenario or 'default'}-seed{seed}"
-        reused = reusable_run(out, config) if reuse else None
+        reused = reusable_mission(out, config) if reuse else None
         if reused:
             metrics = read_metrics_document(out)
         else:

@@ -9,7 +9,7 @@ Sections:
 * ``table3-city-small``, ``-medium``, ``-large``, ``table3-others``, ``acceptance``: 000
   Table 3 over the city's three scenarios, campus, subterranean and both collapsed buildings;
 * ``golden-envelope``: the city small runs' figures as the golden mission's behavioural
-  envelope (``tests/missions/data/golden/city-small-envelope.json``);
+  envelope (``tests/missions/xflie/data/golden/city-small-envelope.json``);
 * ``table5``, ``targets``: 000 Table 5 on the city seed-0 runs (queries answered by both
   planners, the volumetric one over the ground band and the full volume);
 * ``scaling``: the synthetic-city scaling study (000 Fig 13 analogue);
@@ -43,30 +43,31 @@ from typing import Any
 
 import golden_envelope
 import reproduction_missions as missions
-import routine_acceptance
 from mission_acceptance import PAPER, acceptance_lines
 from planning_targets import targets_markdown, targets_met
 from rl_reproduction import SECTIONS as RL_SECTIONS
 from rl_reproduction import regenerate as rl_regenerate
 from seminspect.core.io import atomic_write_text
 from seminspect.core.provenance import platform_label
-from seminspect.missions.xflie.sweep import SweepRow, SweepTask, sweep_tables
-from seminspect.report.markdown import mean_sd, median_range, rewrite_sections, section_body
-from seminspect.runs.directory import read_metrics_document
+from seminspect.missions.xflie.layout import read_metrics_document
+from seminspect.missions.xflie.sweep import MISSIONS
+from seminspect.report.markdown import (
+    mean_sd,
+    median_range,
+    rewrite_sections,
+    section_body,
+    seeds_cell,
+)
+from seminspect.runs.sweep import SweepRow, SweepTask, sweep_tables
+from seminspect.studies.routine import reproduction_sections as routine_sections
+from seminspect.studies.routine import run_study as routine_study
+from seminspect.studies.routine import tour_study
+from seminspect.studies.xflie.missions import TABLE6_PLANNERS, MissionOutcome
 from seminspect.studies.xflie.scaling import SCALING_SIZES, scaling_study
-from seminspect.studies.xflie.study import (
-    TABLE6_PLANNERS,
-    MissionOutcome,
-    PlanningStudy,
-    compare_run,
-)
-from seminspect.studies.xflie.tables import (
-    both_volumes_beside_paper,
-    merge_table6_rows,
-    scaling_markdown,
-    study_document,
-    table6_summary,
-)
+from seminspect.studies.xflie.study import PlanningStudy, compare_run
+from seminspect.studies.xflie.table5 import both_volumes_beside_paper
+from seminspect.studies.xflie.table6 import merge_table6_rows, table6_summary
+from seminspect.studies.xflie.tables import scaling_markdown, study_document
 from team import TARGET_SPEEDUP_PCT
 from team import figures as team_figures
 
@@ -145,7 +146,7 @@ def publish_rows(rows: Sequence[SweepRow]) -> None:
     kept |= {row.name: row for row in rows}
     order = [task.name for task in missions.mission_tasks(missions.section_specs())]
     DATA.mkdir(parents=True, exist_ok=True)
-    sweep_tables([kept[name] for name in order if name in kept], DATA)
+    sweep_tables([kept[name] for name in order if name in kept], DATA, MISSIONS.columns)
 
 
 def run_code(task: SweepTask) -> dict[str, Any]:
@@ -187,7 +188,7 @@ def table3_row(name: str, runs: list[tuple[SweepTask, dict[str, Any]]]) -> str:
     ]
     cells = [
         name,
-        missions.seeds_cell(seeds),
+        seeds_cell(seeds),
         *layers,
         mean_sd((t["reconciled_pct"] for t in t3), 1),
         _pair(t3, lambda t: t["detected_pct"], lambda t: t["inspected_pct"]),
@@ -323,7 +324,7 @@ def team_section(runs: Runs) -> str:
         for s in seeds
     )
     lines.append(
-        f"| {missions.seeds_cell(seeds)} | {cell(lone, 'finish_s')} "
+        f"| {seeds_cell(seeds)} | {cell(lone, 'finish_s')} "
         f"| {cell(lone, 'last_inspection_s')} "
         f"| {cell(team, 'finish_s')} | {cell(team, 'last_inspection_s')} "
         f"| {cell(team, 'exploration_done_s')} | {mean_sd(ratio.values(), 2)} | {outcome} |"
@@ -372,7 +373,8 @@ def regenerate(args: argparse.Namespace) -> dict[str, str]:
     sections |= planning_sections(runs, wanted, args.doc)
     if wanted & set(ROUTINE_SECTIONS):
         log("002 routine inspection, every scenario and seed")
-        routine = routine_acceptance.sections(args.runs / "routine", missions.SEEDS)
+        study = routine_study(args.runs / "routine", missions.SEEDS)
+        routine = routine_sections(study, tour_study())
         sections |= {name: text for name, text in routine.items() if name in wanted}
     if wanted & set(RL_SECTIONS):
         sections |= rl_regenerate(wanted & set(RL_SECTIONS))

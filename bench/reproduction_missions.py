@@ -16,12 +16,13 @@ from __future__ import annotations
 
 import argparse
 import time
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 from pathlib import Path
 
 from seminspect.missions.xflie.config import CITY_BUDGETS
-from seminspect.missions.xflie.sweep import SweepRow, SweepSpec, SweepTask, expand, run_on_ray
-from seminspect.studies.xflie.study import TABLE6_PLANNERS
+from seminspect.missions.xflie.sweep import MISSIONS, SweepSpec, expand
+from seminspect.runs.sweep import SweepRow, SweepTask, run_on_ray
+from seminspect.studies.xflie.missions import TABLE6_PLANNERS
 
 #: Seeds of every mission row of the tables.
 SEEDS = tuple(range(5))
@@ -32,15 +33,6 @@ CITY_SCENARIOS = ("small", "medium", "large")
 TEAM = ("explorer", "inspector")
 TEAM_SCENARIO = "large"
 RUNS = Path("runs/reproduction/missions")
-
-
-def seeds_cell(seeds: Sequence[int]) -> str:
-    """How a table names its seeds: ``0-4`` for a run of three or more, else ``0, 2``."""
-    seeds = sorted(seeds)
-    contiguous = seeds == list(range(seeds[0], seeds[-1] + 1))
-    return (
-        f"{seeds[0]}-{seeds[-1]}" if contiguous and len(seeds) > 2 else ", ".join(map(str, seeds))
-    )
 
 
 def _table3_specs() -> dict[str, list[SweepSpec]]:
@@ -121,7 +113,7 @@ def run_missions(tasks: list[SweepTask]) -> list[SweepRow]:
         error = f" ({row.error})" if row.error else ""
         print(f"[{minutes:5.1f} min] {row.name}: {row.state}, {note}{error}", flush=True)
 
-    return run_on_ray(tasks, on_row=done)
+    return run_on_ray(tasks, MISSIONS, on_row=done)
 
 
 def main() -> None:

@@ -7,7 +7,7 @@ with the ray casting on one thread and on two, each row prints:
 * env-steps/s: room-steps per second of ``InspectionVectorEnv.step``, observations included
   (dynamics, the camera and LiDAR rays, the robot's map, ego maps, rewards, resets);
 * raw ms: one ``embreex`` ``run`` of the same ray batch (the rays the last step cast, built by
-  the environment's own ``_sensor_rays``), the floor a step cannot go below;
+  ``missions.learning.sensors.sensor_rays``), the floor a step cannot go below;
 * env/raw: the step's time over that floor.
 
 Target (issue 12): >= 2,000 env-steps/s with 64 rooms.
@@ -23,7 +23,8 @@ import time
 import numpy as np
 
 from seminspect.missions.learning.baselines import OrbitController, RandomController
-from seminspect.missions.learning.env import EnvConfig, InspectionVectorEnv, _sensor_rays
+from seminspect.missions.learning.env import EnvConfig, InspectionVectorEnv
+from seminspect.missions.learning.sensors import sensor_rays
 
 #: Timed steps per room count: about the same number of room-steps for each.
 STEPS = {1: 600, 8: 150, 64: 40}
@@ -51,7 +52,7 @@ def raw_cast_seconds(env: InspectionVectorEnv, repeats: int = 5) -> tuple[float,
     shift = np.outer(every * env._spacing, (1.0, 0.0, 0.0))
     target_centre = np.array([r.solids.centre[0] for r in rooms]) + shift
     target_size = np.array([r.solids.size[0] for r in rooms])
-    _, _, starts, dirs = _sensor_rays(
+    _, _, starts, dirs = sensor_rays(
         env.positions() + shift,
         env.yaws(),
         env._camera,

@@ -1,9 +1,10 @@
 """004 Tables I-III with the shipped policy, its ablations and the baselines, beside the paper.
 
 Every controller meets the same rooms (seed 0, 100 episodes per obstacle count, 90 s each; the
-rooms are drawn per batch and per room, see ``learning.evaluation``). The evaluations are kept
-as JSON in ``docs/data/rl/``; the tables of docs/reproduction.md are made from those files, and
-``tests/report/test_rl_tables.py`` checks that the document still matches them.
+rooms are drawn per batch and per room, see ``missions.learning.evaluation``). The evaluations
+are kept as JSON in ``docs/data/rl/``; the tables of docs/reproduction.md are made from those
+files by ``seminspect.studies.learning``, and ``tests/studies/learning/test_tables.py`` checks
+that the document still matches them.
 
 * ``rl-table1``: the shipped policy, the orbit and the random controllers at 0/4/9/14/19
   obstacles (004 Table I);
@@ -41,6 +42,7 @@ from seminspect.studies.learning.tables import (
     SECTIONS,
     load_evaluations,
     reproduction_sections,
+    table1_evaluations,
 )
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -105,8 +107,7 @@ def regenerate(
         log(f"not rewriting the tables: no evaluation yet for {', '.join(missing)}")
         return {}
     if "rl-table1" in wanted:
-        curves = {results[n].policy: results[n] for n in NEEDS["rl-table1"]}
-        save_figure(coverage_figure(curves), PICTURE)
+        save_figure(coverage_figure(table1_evaluations(results)), PICTURE)
         save_figure(training_figure(TRAINING_LOGS), TRAINING_PICTURE)
         log(f"drew {PICTURE} and {TRAINING_PICTURE}")
     return reproduction_sections(results, wanted)

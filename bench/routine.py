@@ -23,7 +23,8 @@ import numpy as np
 
 from seminspect.geometry.paths import discrete_frechet, kabsch
 from seminspect.mapping.voxel import VoxelMap
-from seminspect.missions.routine.executive import LIDAR, RoutineConfig, make_robot
+from seminspect.missions.routine.config import RoutineConfig
+from seminspect.missions.routine.prior import LIDAR, make_robot
 from seminspect.missions.routine.run import run_routine
 from seminspect.missions.routine.tasks import default_tasks
 from seminspect.planning.adaptive_cycle import plan_cycle, predict_local_path
@@ -116,8 +117,8 @@ def main() -> None:
         wall = time.perf_counter() - t0
     m = result.metrics
     print(
-        f"receding mission (M_H recorded first): {m['sim_time_s']:.1f} s simulated in "
-        f"{wall:.1f} s wall: {m['sim_time_s'] / wall:.1f}x real time"
+        f"receding mission (M_H recorded first): {m.sim_time_s:.1f} s simulated in "
+        f"{wall:.1f} s wall: {m.sim_time_s / wall:.1f}x real time"
     )
 
 

@@ -28,11 +28,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from seminspect.core.rng import make_rng
+from seminspect.geometry.transforms import quat_from_yaw_pitch
+from seminspect.missions.xflie.build import camera_pitch
 from seminspect.missions.xflie.config import make_config, resolve
-from seminspect.missions.xflie.run import camera_pitch
 from seminspect.perception.similarity import (
     ORB_GAMMA_THRESHOLD,
     ImageFeatures,
@@ -81,7 +81,7 @@ class Rig:
         )
 
     def features(self, matcher: SceneMatcher, position, yaw: float) -> ImageFeatures:
-        orientation = Rotation.from_euler("ZY", [yaw, self.pitch]).as_quat()
+        orientation = quat_from_yaw_pitch(yaw, self.pitch)
         noise = mission_noise("realistic", None)
         frame = render(self.world, self.camera, position, orientation, noise=noise, rng=self.rng)
         return matcher.features(frame.intensity)

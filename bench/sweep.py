@@ -16,7 +16,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from seminspect.missions.xflie.sweep import SweepSpec, expand, run_on_ray
+from seminspect.missions.xflie.sweep import MISSIONS, SweepSpec, expand
+from seminspect.runs.sweep import run_on_ray
 
 
 def measure(missions: int, budget: float, workers: int) -> dict[str, float]:
@@ -34,7 +35,7 @@ def measure(missions: int, budget: float, workers: int) -> dict[str, float]:
         ray_start = time.perf_counter() - start
         try:
             start = time.perf_counter()
-            rows = run_on_ray(tasks)  # uses the Ray started above
+            rows = run_on_ray(tasks, MISSIONS)  # uses the Ray started above
             wall = time.perf_counter() - start
         finally:
             ray.shutdown()

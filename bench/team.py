@@ -23,8 +23,10 @@ from pathlib import Path
 from typing import Any
 
 from seminspect.missions.xflie.config import make_config, resolve
+from seminspect.missions.xflie.layout import read_metrics_document
 from seminspect.missions.xflie.run import run_mission
-from seminspect.runs.directory import read_metrics_document, read_run_config, read_run_status
+from seminspect.runs.directory import read_run_config
+from seminspect.runs.status import read_run_status
 
 KINDS = {"one": None, "team": ["explorer", "inspector"]}
 TARGET_SPEEDUP_PCT = 30.0

@@ -20,7 +20,8 @@ from seminspect.mapping.voxel import VoxelMap, load_map
 from seminspect.missions.xflie.config import ResolvedMissionConfig, make_config, resolve
 from seminspect.missions.xflie.metrics import MissionMetrics, QueryAnswer
 from seminspect.missions.xflie.run import run_mission
-from seminspect.runs.directory import load_trajectory, read_run_config
+from seminspect.runs.directory import read_run_config
+from seminspect.runs.trajectory import load_trajectory
 from seminspect.worlds import World, generate_world
 
 REPO = Path(__file__).resolve().parents[1]
@@ -191,8 +192,9 @@ def small_mission(small_mission_dir: Path) -> SavedRun:
 
 
 def pytest_terminal_summary(terminalreporter: pytest.TerminalReporter) -> None:
-    """Say which checks the golden mission ran (``tests/missions/test_golden.py``): exact, on a
-    machine with a golden file, and the behavioural envelope, everywhere; or why one skipped."""
+    """Say which checks the golden mission ran (``tests/missions/xflie/test_golden.py``): exact,
+    on a machine with a golden file, and the behavioural envelope, everywhere; or why one
+    skipped."""
     lines = []
     for report in terminalreporter.stats.get("passed", []):
         lines += [str(value) for name, value in report.user_properties if name == "golden check"]

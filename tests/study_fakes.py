@@ -6,10 +6,10 @@ from pathlib import Path
 import numpy as np
 
 from seminspect.studies.xflie.comparison import HierarchicalTiming, VolumetricResult
+from seminspect.studies.xflie.missions import MissionOutcome
 from seminspect.studies.xflie.scaling import ScalingPoint
 from seminspect.studies.xflie.study import (
     RESOLUTIONS,
-    MissionOutcome,
     PathCheck,
     PlanningStudy,
     QueryComparison,

@@ -8,7 +8,8 @@ from pathlib import Path
 import pytest
 
 from bench_scripts import bench_script
-from seminspect.missions.xflie.sweep import SweepRow, sweep_tables
+from seminspect.missions.xflie.sweep import MISSIONS
+from seminspect.runs.sweep import SweepRow, sweep_tables
 
 REPO = Path(__file__).resolve().parents[2]
 #: The envelope's figures under the sweep's column names.
@@ -34,7 +35,7 @@ compare_runs = bench_script("compare_runs")
 
 def _city_small_runs() -> list[dict[str, float]]:
     """The recorded city small missions (the golden envelope's seeds), as sweep figures."""
-    path = REPO / "tests/missions/data/golden/city-small-envelope.json"
+    path = REPO / "tests/missions/xflie/data/golden/city-small-envelope.json"
     runs = json.loads(path.read_text(encoding="utf-8"))["runs"]
     return [{column: run[name] for column, name in SWEEP_NAMES.items()} for run in runs]
 
@@ -50,7 +51,7 @@ def _write_sweep(directory: Path, runs: list[dict[str, float]], **scaled: float)
         )
         for seed, run in enumerate(runs)
     ]
-    sweep_tables(rows, directory)
+    sweep_tables(rows, directory, MISSIONS.columns)
     return directory
 
 

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 from bench_scripts import bench_script
-from seminspect.missions.xflie.sweep import SweepTask
+from seminspect.runs.sweep import SweepTask
 
 reproduction = bench_script("reproduction")
 
 
 def _run(seed: int, feature: int, rmse: float, sim_s: float, false_targets: int = 0):
-    task = SweepTask(f"city-small-seed{seed}", "city small", {"seed": seed}, "unused")
+    task = SweepTask(f"city-small-seed{seed}", "city small", {"seed": seed}, "unused", seed)
     metrics = {
         "table3": {
             "target": [6, 14], "level": [10, 5], "pose": [130 + seed, 130 + seed],

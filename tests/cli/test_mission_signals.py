@@ -12,7 +12,8 @@ from pathlib import Path
 import pytest
 
 from seminspect.graphs.lsg.io import load_graph
-from seminspect.runs.directory import LOCK_FILE, read_run_status
+from seminspect.runs.lock import LOCK_FILE
+from seminspect.runs.status import read_run_status
 
 SRC = Path(__file__).resolve().parents[2] / "src"
 

@@ -75,7 +75,7 @@ def test_via_points_are_driven_between_targets() -> None:
     graph = synthetic_graph(2, poses_per_level=4, neighbours=0)
     edge = graph.edge("car-0", "car-1")
     graph.target_graph.edges.pop(edge.key)
-    graph._edges.pop(edge.key)  # replace the straight link by a detour
+    graph.unified.edges.pop(edge.key)  # replace the straight link by a detour
     graph.connect_targets("car-1", "car-0", via=[[5.0, 60.0, 0.7]])
     start = graph.target("car-0").levels[0].position
     plan = HierarchicalPlanner(graph).plan("car-1/Level-0", start)

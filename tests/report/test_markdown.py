@@ -8,6 +8,7 @@ from seminspect.report.markdown import (
     rewrite_sections,
     section_body,
     section_names,
+    seeds_cell,
 )
 
 DOC = """# Results
@@ -80,3 +81,10 @@ def test_a_figure_over_seeds_is_mean_and_spread_and_a_count_median_and_range() -
     assert median_range([150, 155, 167, 152]) == "154 [150-167]"
     assert median_range([6, 6, 6]) == "6"
     assert median_range([]) == "-"
+
+
+def test_seeds_are_named_as_a_run_or_one_by_one() -> None:
+    assert seeds_cell([4, 0, 1, 2, 3]) == "0-4"
+    assert seeds_cell([0, 2, 3]) == "0, 2, 3"
+    assert seeds_cell([1, 2]) == "1, 2"  # two seeds are listed, not a run
+    assert seeds_cell([3]) == "3"

@@ -1,6 +1,6 @@
 import pytest
 
-from seminspect.missions.routine.executive import RoutineConfig
+from seminspect.missions.routine.config import RoutineConfig
 from seminspect.missions.routine.run import run_routine
 from seminspect.report.routine import comparison_figure, load_views, render_routine
 

@@ -2,7 +2,7 @@ import matplotlib.pyplot as plt
 import pytest
 
 from seminspect.report.run_pictures import load_events, render_run, timeline_figure
-from seminspect.runs.directory import load_trajectory
+from seminspect.runs.trajectory import load_trajectory
 
 
 @pytest.mark.slow

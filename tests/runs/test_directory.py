@@ -3,6 +3,7 @@ reads a dead writer as dead, and reuse that says why not."""
 
 import json
 import os
+import re
 import subprocess
 import sys
 import time
@@ -15,22 +16,22 @@ import pytest
 from seminspect.core.errors import InvalidInputError, SeminspectError
 from seminspect.core.provenance import code_version
 from seminspect.mapping.voxel import VoxelMap, save_map
-from seminspect.missions.xflie.config import make_config, resolve
-from seminspect.runs.directory import (
-    LOCK_FILE,
-    RunDirectory,
-    RunDirectoryInUseError,
-    RunDirectoryWarning,
-    RunEnd,
-    conduct_run,
-    load_robot_trajectories,
-    load_trajectory,
-    read_run_status,
-    resumable_config,
-    reusable_run,
-)
+from seminspect.runs.conduct import RunEnd, conduct_run
+from seminspect.runs.directory import RunDirectory, RunLayout
+from seminspect.runs.lock import LOCK_FILE, RunDirectoryInUseError, RunDirectoryWarning
+from seminspect.runs.reuse import resumable_config, reusable_run
+from seminspect.runs.status import read_run_status
+from seminspect.runs.trajectory import load_robot_trajectories, load_trajectory
 
 CONFIG = {"world": "subterranean", "seed": 0}
+#: What a program writes besides the common files, as a program declares it.
+LAYOUT = RunLayout(
+    files=frozenset({"map.npz"}),
+    folders={
+        "snapshots": re.compile(r"graph-[\d.]+s\.json"),
+        "robots": re.compile(r"[a-z]+-trajectory\.csv"),
+    },
+)
 
 
 def test_a_claimed_directory_refuses_a_second_writer_naming_the_first(tmp_path) -> None:
@@ -88,14 +89,14 @@ def test_a_new_run_clears_the_old_runs_files_but_never_a_strangers(tmp_path) -> 
     (root / "images" / "car-1-00003.jpg").write_bytes(b"jpg")
     (root / "graph.png").write_bytes(b"png")
     (root / ".metrics.json.k2j4h1.tmp").write_text("{")  # an atomic write cut short
-    with RunDirectory(root).claimed(CONFIG) as run:
+    with RunDirectory(root, LAYOUT).claimed(CONFIG) as run:
         assert sorted(p.name for p in root.iterdir()) == ["config.json", LOCK_FILE, "status.json"]
         run.finish("completed")
     (root / "notes.txt").write_text("mine")
     (root / "images").mkdir()
     (root / "images" / "holiday.png").write_bytes(b"png")
     with pytest.raises(InvalidInputError, match=r"images, notes\.txt"):
-        RunDirectory(root).claimed(CONFIG).__enter__()  # refused before the claim is made
+        RunDirectory(root, LAYOUT).claimed(CONFIG).__enter__()  # refused before the claim
     assert (root / "notes.txt").exists() and (root / "config.json").exists()
     assert not (root / LOCK_FILE).exists()
 
@@ -105,7 +106,7 @@ def test_a_teams_trajectories_are_written_per_robot_and_cleared_by_the_next_run(
 ) -> None:
     root = tmp_path / "run"
     rows = {"explorer": [[0.0] * 9, [1.0] * 9], "inspector": [[2.0] * 9]}
-    with RunDirectory(root).claimed(CONFIG) as run:
+    with RunDirectory(root, LAYOUT).claimed(CONFIG) as run:
         run.write_trajectory(rows["explorer"])
         for robot, robot_rows in rows.items():
             run.write_trajectory(robot_rows, robot)
@@ -113,7 +114,7 @@ def test_a_teams_trajectories_are_written_per_robot_and_cleared_by_the_next_run(
     trajectories = load_robot_trajectories(root)
     assert {k: v.tolist() for k, v in trajectories.items()} == rows
     assert load_trajectory(root).tolist() == rows["explorer"]
-    with RunDirectory(root).claimed(CONFIG) as run:  # a one-robot run over a team's
+    with RunDirectory(root, LAYOUT).claimed(CONFIG) as run:  # a one-robot run over a team's
         assert load_robot_trajectories(root) == {}
         run.finish("completed")
 
@@ -129,44 +130,43 @@ def test_a_failure_inside_the_claim_is_recorded(tmp_path) -> None:
     assert read_run_status(run.root).state == "interrupted"
 
 
-def _stored_run(root: Path, config, state: str = "completed") -> Path:
-    with RunDirectory(root).claimed(config.model_dump(mode="json")) as run:
+def _stored_run(root: Path, config: dict, state: str = "completed") -> Path:
+    with RunDirectory(root, LAYOUT).claimed(config) as run:
         save_map(root / "map.npz", VoxelMap.empty([0, 0, 0], [1, 1, 1], 0.5))
         run.finish(state)
     return root
 
 
 def test_reuse_says_why_a_run_cannot_stand_for_a_new_one(tmp_path) -> None:
-    config = resolve(make_config(CONFIG))
-    same = _stored_run(tmp_path / "same", config)
-    assert reusable_run(same, config) and not reusable_run(same, config).reason
-    other = reusable_run(same, config.model_copy(update={"seed": 3}))
+    same = _stored_run(tmp_path / "same", CONFIG)
+    assert reusable_run(same, CONFIG) and not reusable_run(same, CONFIG).reason
+    other = reusable_run(same, {**CONFIG, "seed": 3})
     assert not other and "seed: 0 -> 3" in other.reason
-    stopped = reusable_run(_stored_run(tmp_path / "stopped", config, "interrupted"), config)
+    missing = reusable_run(same, CONFIG, needs=("map.npz", "graph.json"))
+    assert not missing and missing.reason.endswith("has no graph.json")
+    stopped = reusable_run(_stored_run(tmp_path / "stopped", CONFIG, "interrupted"), CONFIG)
     assert not stopped and "interrupted" in stopped.reason
-    assert "no readable run" in reusable_run(tmp_path / "missing", config).reason
+    assert "no readable run" in reusable_run(tmp_path / "missing", CONFIG).reason
     document = json.loads((same / "config.json").read_text())
     document["code"]["source_sha256"] = "0" * 64
     document["code"]["dependencies"]["numpy"] = "0.1"
     (same / "config.json").write_text(json.dumps(document))
-    changed = reusable_run(same, config)
+    changed = reusable_run(same, CONFIG)
     assert not changed and "source changed" in changed.reason and "numpy 0.1 ->" in changed.reason
 
 
 def test_a_run_made_on_another_kind_of_cpu_is_not_reused(tmp_path) -> None:
-    config = resolve(make_config(CONFIG))
-    stored = _stored_run(tmp_path / "r", config)
+    stored = _stored_run(tmp_path / "r", CONFIG)
     document = json.loads((stored / "config.json").read_text())
     document["code"]["platform"]["cpu_vendor"] = "OtherVendor"
     (stored / "config.json").write_text(json.dumps(document))
-    elsewhere = reusable_run(stored, config)
+    elsewhere = reusable_run(stored, CONFIG)
     assert not elsewhere and "another kind of machine" in elsewhere.reason
     assert "OtherVendor" in elsewhere.reason
 
 
 def test_the_run_records_the_code_and_libraries(tmp_path) -> None:
-    config = resolve(make_config(CONFIG))
-    document = json.loads((_stored_run(tmp_path / "r", config) / "config.json").read_text())
+    document = json.loads((_stored_run(tmp_path / "r", CONFIG) / "config.json").read_text())
     assert document["code"] == code_version()
     assert (
         document["code"]["dependencies"]["numpy"] and len(document["code"]["source_sha256"]) == 64
@@ -174,12 +174,11 @@ def test_the_run_records_the_code_and_libraries(tmp_path) -> None:
 
 
 def test_only_an_unfinished_run_can_be_resumed(tmp_path) -> None:
-    config = resolve(make_config(CONFIG))
-    done = _stored_run(tmp_path / "done", config)
+    done = _stored_run(tmp_path / "done", CONFIG)
     with pytest.raises(InvalidInputError, match="completed run; nothing to resume"):
         resumable_config(done)
-    failed = _stored_run(tmp_path / "failed", config, "failed")
-    assert resumable_config(failed) == config.model_dump(mode="json")
+    failed = _stored_run(tmp_path / "failed", CONFIG, "failed")
+    assert resumable_config(failed) == CONFIG
     with pytest.raises(InvalidInputError, match="not a run directory"):
         resumable_config(tmp_path)
 

@@ -143,7 +143,7 @@ def _resumed(ctx: typer.Context, run_dir: Path):
     """The configuration and directory of a run to finish; mission settings may not be mixed in."""
     from seminspect.core.errors import InvalidInputError
     from seminspect.missions.xflie.config import make_config
-    from seminspect.runs.directory import resumable_config
+    from seminspect.runs.reuse import resumable_config
 
     given = [
         f"--{name}"

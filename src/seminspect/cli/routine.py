@@ -30,7 +30,7 @@ _CURRENT = typer.Option(
 def _config_and_site(world, scenario, seed, length, historical, current, *, need_current=True):
     """The settings, and the user's site pair when --historical/--current are given."""
     from seminspect.core.errors import InvalidInputError
-    from seminspect.missions.routine.executive import RoutineConfig
+    from seminspect.missions.routine.config import RoutineConfig
     from seminspect.worlds.routine_sites import user_site, world_files
 
     if historical is None and current is None:
@@ -133,10 +133,10 @@ def _print_result(name: str, result) -> None:
     if not m:
         return
     console.print(
-        f"  tasks {m['tasks_completed']}/{m['tasks_total']}, utility "
-        f"{_num(m['viewpoint_utility_mean'])}, viewing-distance MAE "
-        f"{_num(m['view_distance_mae_m'])} m, ROI coverage {_num(m['roi_coverage_pct'], 1)} %, "
-        f"max Γ_s {_num(m['gamma_s_max'])}, collisions {m['collisions']}"
+        f"  tasks {m.tasks_completed}/{m.tasks_total}, utility "
+        f"{_num(m.viewpoint_utility_mean)}, viewing-distance MAE "
+        f"{_num(m.view_distance_mae_m)} m, ROI coverage {_num(m.roi_coverage_pct, 1)} %, "
+        f"max Γ_s {_num(m.gamma_s_max)}, collisions {m.collisions}"
     )
     console.print(f"  results: {result.run_dir} (summary.md, metrics.json, *.png)")
 

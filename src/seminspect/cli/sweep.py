@@ -71,13 +71,8 @@ def app(
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
     from seminspect.core.errors import InvalidInputError
-    from seminspect.missions.xflie.sweep import (
-        SweepSpec,
-        expand,
-        load_spec,
-        run_on_ray,
-        sweep_tables,
-    )
+    from seminspect.missions.xflie.sweep import MISSIONS, SweepSpec, expand, load_spec
+    from seminspect.runs.sweep import run_on_ray, sweep_tables
 
     if grid is not None:
         if world or scenario or setting:
@@ -106,8 +101,8 @@ def app(
             failed += row.state == "failed"
             progress.update(bar, advance=1, failed=failed, last=f"{row.name}: {row.state}")
 
-        rows = run_on_ray(tasks, workers=workers, address=address, on_row=show)
-    written = sweep_tables(rows, out)
+        rows = run_on_ray(tasks, MISSIONS, workers=workers, address=address, on_row=show)
+    written = sweep_tables(rows, out, MISSIONS.columns)
     console.print((out / "sweep.md").read_text(encoding="utf-8"), markup=False, highlight=False)
     console.print(f"tables: {', '.join(str(p) for p in written)}", highlight=False)
     failures = [r for r in rows if r.state == "failed"]

@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
 from seminspect.cli._common import console, labelled, writable_directory, writable_file
+
+if TYPE_CHECKING:
+    from seminspect.graphs.terrain.evaluate import ObjectQuality
 
 app = typer.Typer(no_args_is_help=True, help="Terrain-aware, task-driven outdoor scene graphs.")
 
@@ -16,6 +20,40 @@ _GRAPH_HELP = """Build the task-driven scene graph (001 Sec III-B) of a cloud or
 
 INPUT is a .ply/.pcd/.npz cloud with per-point embeddings or labels, a semantic cloud saved by
 seminspect, or SemanticKITTI .bin scans with --labels (one per scan, same order)."""
+
+# Options that do not fit on the command's line, and those both commands share.
+_ENCODER_OPTION = typer.Option(
+    "minilm",
+    "--encoder",
+    help="Registered encoder name, or package.module:factory, which imports that module "
+    "and runs the factory (only name code you trust).",
+)
+_RADIUS_OPTION = typer.Option(0.15, help="Association radius of scan points to map points [m].")
+_OBJECTS_OPTION = typer.Option(
+    "image of a tree,image of a car", help="Object prompts, comma-separated."
+)
+_CLOUD_LABEL_NAMES_OPTION = typer.Option(
+    None, help="Names of a cloud's integer labels, e.g. '0=grass,1=car'."
+)
+_EVALUATE_OPTION = typer.Option(
+    False,
+    help="Score against ground truth: SemanticKITTI instance labels, or the simulated "
+    "world a 'terrain map' cloud came from.",
+)
+_WORLD_OPTION = typer.Option(
+    "outdoor", help="World with a drive path: a built-in name or a user world folder."
+)
+_SCENARIO_OPTION = typer.Option(
+    None, "--scenario", "-s", help="World scenario (the world's default when omitted)."
+)
+_BAG_OPTION = typer.Option(
+    None, "--bag", help="Map a ROS1/ROS2 bag's labelled clouds instead of a simulated world."
+)
+_BAG_LABEL_NAMES_OPTION = typer.Option(
+    None,
+    help="Names of the bag's labels, e.g. '0=grass,1=car' (default: the bag's own names "
+    "topic, else SemanticKITTI's table).",
+)
 
 
 def _param_overrides(items: list[str], cell_size: float | None) -> dict[str, Any]:
@@ -103,14 +141,19 @@ def _encoder(name: str, noise: float, seed: int):
     return encoder
 
 
-def _kitti_quality(build, fused, encoder) -> dict[str, Any]:
+def _kitti_quality(build, fused, encoder) -> dict[str, ObjectQuality]:
     """Object precision/recall against the scans' own instance labels.
 
     A prompt is matched against every class of the label table, so 'trunk' is the trunk class;
     only SemanticKITTI's "things" carry instance ids, and a prompt naming any other class is
     reported unscored rather than scored against the nearest thing.
     """
-    from seminspect.graphs.terrain.evaluate import match_boxes, match_class, predicted_boxes
+    from seminspect.graphs.terrain.evaluate import (
+        ObjectQuality,
+        match_boxes,
+        match_class,
+        predicted_boxes,
+    )
     from seminspect.mapping.formats.semantickitti import instance_boxes, label_table
 
     table = label_table()
@@ -122,31 +165,70 @@ def _kitti_quality(build, fused, encoder) -> dict[str, Any]:
         if table.learning_map[raw] in things
     }
     classes = sorted(set(table.names.values()))
-    report: dict[str, Any] = {}
+    report: dict[str, ObjectQuality] = {}
     for prompt in build.scene.prompts.objects:
         match = match_class(encoder, prompt, classes, build.scene.calibration.objects)
-        report[prompt] = match.as_dict()
         if match.truth not in ids:
+            unscored = None
             if match.truth is not None:
-                report[prompt]["unscored"] = f"SemanticKITTI has no instances of {match.truth!r}"
+                unscored = f"SemanticKITTI has no instances of {match.truth!r}"
+            report[prompt] = ObjectQuality(match, unscored=unscored)
             continue
         boxes = instance_boxes(
             fused.points, fused.semantic, fused.instance, ids[match.truth], min_points=1
         )
         scores = match_boxes(predicted_boxes(build.scene, prompt), boxes, threshold=0.3)
-        report[prompt].update(scores.as_dict())
+        report[prompt] = ObjectQuality(match, scores)
     return report
 
 
+def _require_truth(cloud, fused) -> None:
+    """``--evaluate`` needs instance-labelled scans or a cloud that records its world."""
+    from seminspect.core.errors import InvalidInputError
+
+    if fused is None and "world" not in cloud.source:
+        raise InvalidInputError(
+            "--evaluate needs SemanticKITTI scans with instance labels "
+            "or a cloud from 'seminspect terrain map'"
+        )
+
+
 def _quality(build, cloud, fused, encoder) -> dict[str, Any]:
-    """Scores against the scans' instance labels, or against the simulated world's truth."""
+    """Scores against the scans' instance labels, or against the simulated world's truth, as
+    ``summary.json`` records them."""
     from seminspect.missions.terrain.mapping import evaluate_on_world, source_world
 
     if fused is not None:
-        return _kitti_quality(build, fused, encoder)
+        return {p: q.to_json() for p, q in _kitti_quality(build, fused, encoder).items()}
     world = source_world(cloud)
     assert world is not None, "the command checks for a source world before building"
-    return evaluate_on_world(build, world, encoder)
+    return evaluate_on_world(build, world, encoder).to_json()
+
+
+def _calibration(encoder_name: str, terrain: float | None, objects: float | None):
+    """The encoder's calibrated thresholds, with the ones given on the command line."""
+    import dataclasses
+
+    from seminspect.perception.encoders import calibration_for
+
+    calibration = calibration_for(encoder_name)
+    if terrain is None and objects is None:
+        return calibration
+    return dataclasses.replace(
+        calibration,
+        terrain=calibration.terrain if terrain is None else terrain,
+        objects=calibration.objects if objects is None else objects,
+    )
+
+
+def _stage_reporter(progress) -> Callable[[str], None]:
+    """A progress task for phase 2's stages, advanced by the returned callback."""
+    stages = progress.add_task("phase 2", total=5)
+
+    def on_stage(name: str) -> None:
+        progress.update(stages, description=f"phase 2: {name}", advance=1)
+
+    return on_stage
 
 
 def _write_outputs(out: Path, build, cloud, progress) -> None:
@@ -178,82 +260,13 @@ def _slug(text: str) -> str:
     return "".join(ch if ch.isalnum() else "_" for ch in text).strip("_") or "terrain"
 
 
-@app.command("graph", help=_GRAPH_HELP)
-def graph(
-    inputs: list[Path] = typer.Argument(..., help="Cloud file, or SemanticKITTI .bin scans."),
-    out: Path = typer.Option(..., "--out", help="Directory for the graph, summary and pictures."),
-    terrain: str = typer.Option("sidewalk,grass,asphalt", help="Terrain prompts, comma-separated."),
-    objects: str = typer.Option(
-        "image of a tree,image of a car", help="Object prompts, comma-separated."
-    ),
-    labels: list[Path] = typer.Option([], "--labels", help="SemanticKITTI .label, one per scan."),
-    poses: Path | None = typer.Option(None, help="KITTI poses.txt (fuses several scans)."),
-    calib: Path | None = typer.Option(None, help="KITTI calib.txt (with --poses)."),
-    label_names: str | None = typer.Option(
-        None, help="Names of a cloud's integer labels, e.g. '0=grass,1=car'."
-    ),
-    encoder_name: str = typer.Option(
-        "minilm",
-        "--encoder",
-        help="Registered encoder name, or package.module:factory, which imports that module "
-        "and runs the factory (only name code you trust).",
-    ),
-    noise: float = typer.Option(0.0, help="Caption noise per view (labelled input)."),
-    seed: int = typer.Option(0, help="Seed of the caption noise."),
-    radius: float = typer.Option(0.15, help="Association radius of scan points to map points [m]."),
-    terrain_threshold: float | None = typer.Option(None, help="Override the terrain threshold."),
-    object_threshold: float | None = typer.Option(None, help="Override α, the object threshold."),
-    cell_size: float | None = typer.Option(None, help="Terrain grid cell size [m]."),
-    param: list[str] = typer.Option([], help="Any graph parameter as NAME=VALUE (repeatable)."),
-    evaluate: bool = typer.Option(
-        False,
-        help="Score against ground truth: SemanticKITTI instance labels, or the simulated "
-        "world a 'terrain map' cloud came from.",
-    ),
-) -> None:
-    import dataclasses
+def _write_summary(out: Path, cloud, build, quality: dict[str, Any] | None) -> dict[str, Any]:
+    """``summary.json`` and ``report.html`` of a graph directory; returns the summary."""
     import json
 
-    from rich.progress import Progress
-
-    from seminspect.core.errors import InvalidInputError
     from seminspect.core.io import atomic_write_text
-    from seminspect.graphs.terrain.params import make_terrain_params
-    from seminspect.graphs.terrain.prompting import TaskPrompts
-    from seminspect.graphs.terrain.scene_graph import build_terrain_graph
-    from seminspect.perception.encoders import calibration_for
     from seminspect.report.html import write_terrain_report
 
-    writable_directory(out)
-    _positive_radius(radius)
-    prompts = TaskPrompts.parse(terrain, objects)
-    params = make_terrain_params(_param_overrides(param, cell_size))
-    encoder = _encoder(encoder_name, noise, seed)
-    calibration = calibration_for(encoder.name)
-    if terrain_threshold is not None or object_threshold is not None:
-        calibration = dataclasses.replace(
-            calibration,
-            terrain=calibration.terrain if terrain_threshold is None else terrain_threshold,
-            objects=calibration.objects if object_threshold is None else object_threshold,
-        )
-    options = {"poses": poses, "calib": calib, "radius": radius, "label_names": label_names}
-    with Progress(console=console, transient=True) as progress:
-        cloud, fused = _load_cloud(inputs, labels, options, encoder, progress)
-        if evaluate and fused is None and "world" not in cloud.source:
-            raise InvalidInputError(
-                "--evaluate needs SemanticKITTI scans with instance labels "
-                "or a cloud from 'seminspect terrain map'"
-            )
-        stages = progress.add_task("phase 2", total=5)
-
-        def on_stage(name: str) -> None:
-            progress.update(stages, description=f"phase 2: {name}", advance=1)
-
-        build = build_terrain_graph(
-            cloud, prompts, encoder, params=params, calibration=calibration, on_stage=on_stage
-        )
-        quality = _quality(build, cloud, fused, encoder) if evaluate else None
-        _write_outputs(out, build, cloud, progress)
     summary = {
         "cloud_points": len(cloud),
         **build.scene.summary(),
@@ -262,10 +275,62 @@ def graph(
     }
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2) + "\n")
     write_terrain_report(out)
+    return summary
+
+
+def _print_graph_summary(out: Path, summary: dict[str, Any]) -> None:
+    import json
+
     console.print(
         labelled("terrain graph", "bold", f"written to {out} (open report.html in a browser)")
     )
     console.print_json(json.dumps({k: v for k, v in summary.items() if k != "seconds"}))
+
+
+@app.command("graph", help=_GRAPH_HELP)
+def graph(
+    inputs: list[Path] = typer.Argument(..., help="Cloud file, or SemanticKITTI .bin scans."),
+    out: Path = typer.Option(..., "--out", help="Directory for the graph, summary and pictures."),
+    terrain: str = typer.Option("sidewalk,grass,asphalt", help="Terrain prompts, comma-separated."),
+    objects: str = _OBJECTS_OPTION,
+    labels: list[Path] = typer.Option([], "--labels", help="SemanticKITTI .label, one per scan."),
+    poses: Path | None = typer.Option(None, help="KITTI poses.txt (fuses several scans)."),
+    calib: Path | None = typer.Option(None, help="KITTI calib.txt (with --poses)."),
+    label_names: str | None = _CLOUD_LABEL_NAMES_OPTION,
+    encoder_name: str = _ENCODER_OPTION,
+    noise: float = typer.Option(0.0, help="Caption noise per view (labelled input)."),
+    seed: int = typer.Option(0, help="Seed of the caption noise."),
+    radius: float = _RADIUS_OPTION,
+    terrain_threshold: float | None = typer.Option(None, help="Override the terrain threshold."),
+    object_threshold: float | None = typer.Option(None, help="Override α, the object threshold."),
+    cell_size: float | None = typer.Option(None, help="Terrain grid cell size [m]."),
+    param: list[str] = typer.Option([], help="Any graph parameter as NAME=VALUE (repeatable)."),
+    evaluate: bool = _EVALUATE_OPTION,
+) -> None:
+    from rich.progress import Progress
+
+    from seminspect.graphs.terrain.params import make_terrain_params
+    from seminspect.graphs.terrain.prompting import TaskPrompts
+    from seminspect.graphs.terrain.scene_graph import build_terrain_graph
+
+    writable_directory(out)
+    _positive_radius(radius)
+    prompts = TaskPrompts.parse(terrain, objects)
+    params = make_terrain_params(_param_overrides(param, cell_size))
+    encoder = _encoder(encoder_name, noise, seed)
+    calibration = _calibration(encoder.name, terrain_threshold, object_threshold)
+    options = {"poses": poses, "calib": calib, "radius": radius, "label_names": label_names}
+    with Progress(console=console, transient=True) as progress:
+        cloud, fused = _load_cloud(inputs, labels, options, encoder, progress)
+        if evaluate:
+            _require_truth(cloud, fused)
+        on_stage = _stage_reporter(progress)
+        build = build_terrain_graph(
+            cloud, prompts, encoder, params=params, calibration=calibration, on_stage=on_stage
+        )
+        quality = _quality(build, cloud, fused, encoder) if evaluate else None
+        _write_outputs(out, build, cloud, progress)
+    _print_graph_summary(out, _write_summary(out, cloud, build, quality))
 
 
 @app.command("route")
@@ -288,33 +353,18 @@ def route(
 @app.command("map")
 def map_command(
     out: Path = typer.Option(..., "--out", help="The semantic cloud to write (.npz)."),
-    world: str = typer.Option(
-        "outdoor", help="World with a drive path: a built-in name or a user world folder."
-    ),
-    scenario: str | None = typer.Option(
-        None, "--scenario", "-s", help="World scenario (the world's default when omitted)."
-    ),
+    world: str = _WORLD_OPTION,
+    scenario: str | None = _SCENARIO_OPTION,
     seed: int = typer.Option(0, help="Seed of the world and of the caption noise."),
-    encoder_name: str = typer.Option(
-        "minilm",
-        "--encoder",
-        help="Registered encoder name, or package.module:factory, which imports that module "
-        "and runs the factory (only name code you trust).",
-    ),
+    encoder_name: str = _ENCODER_OPTION,
     noise: float = typer.Option(0.3, help="Caption noise per view (caption encoders)."),
     spacing: float = typer.Option(1.0, help="Metres driven between frames."),
-    radius: float = typer.Option(0.15, help="Association radius of scan points to map points [m]."),
-    bag: Path | None = typer.Option(
-        None, "--bag", help="Map a ROS1/ROS2 bag's labelled clouds instead of a simulated world."
-    ),
+    radius: float = _RADIUS_OPTION,
+    bag: Path | None = _BAG_OPTION,
     cloud_topic: str = typer.Option("/points", help="PointCloud2 topic of the bag."),
     odom_topic: str = typer.Option("/odom", help="Odometry topic of the bag (the cloud's pose)."),
     labels_field: str = typer.Option("label", help="Integer label field of the bag's clouds."),
-    label_names: str | None = typer.Option(
-        None,
-        help="Names of the bag's labels, e.g. '0=grass,1=car' (default: the bag's own names "
-        "topic, else SemanticKITTI's table).",
-    ),
+    label_names: str | None = _BAG_LABEL_NAMES_OPTION,
 ) -> None:
     """Phase 1 (001 Sec III-A) in the simulator: drive a world's path, fuse LiDAR and camera.
 
@@ -326,26 +376,36 @@ def map_command(
         bag_topics = (cloud_topic, odom_topic, labels_field, label_names)
         _map_bag(bag, bag_topics, out, _encoder(encoder_name, noise, seed), radius)
         return
-    from rich.progress import MofNCompleteColumn, Progress, TimeElapsedColumn
-
     from seminspect.mapping.semantic_cloud import save_cloud
-    from seminspect.missions.terrain.mapping import make_mapping_params, map_world
+    from seminspect.missions.terrain.mapping import make_mapping_params
     from seminspect.worlds import open_world
 
     writable_file(out, (".npz",))
     params = make_mapping_params({"spacing": spacing, "radius": radius})
     site = open_world(world, scenario, seed)
-    encoder = _encoder(encoder_name, noise, seed)
+    run = _drive_with_progress(site, _encoder(encoder_name, noise, seed), params)
+    save_cloud(out, run.cloud)
+    _print_mapping(out, run)
+
+
+def _drive_with_progress(site, encoder, params):
+    """Phase 1 in the simulator, with a frame counter."""
+    from rich.progress import MofNCompleteColumn, Progress, TimeElapsedColumn
+
+    from seminspect.missions.terrain.mapping import map_world
+
     columns = (*Progress.get_default_columns()[:2], MofNCompleteColumn(), TimeElapsedColumn())
     with Progress(*columns, console=console, transient=True) as progress:
         task = progress.add_task("phase 1: scanning and fusing", total=None)
-        run = map_world(
+        return map_world(
             site,
             encoder,
             params=params,
             on_frame=lambda done, total: progress.update(task, completed=done, total=total),
         )
-    save_cloud(out, run.cloud)
+
+
+def _print_mapping(out: Path, run) -> None:
     seconds = run.seconds
     console.print(
         labelled(

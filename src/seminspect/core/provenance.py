@@ -3,7 +3,7 @@ versions of the libraries whose behaviour shapes the numbers and the machine's f
 paths.
 
 A run directory records this so a later reader can tell whether a stored run still stands for
-the current code on the current machine (see ``missions.rundir.reusable_run``).
+the current code on the current machine (see ``runs.reuse.reusable_run``).
 """
 
 from __future__ import annotations

@@ -141,6 +141,44 @@ class _Network:
     owner: NDArray[np.int64]
     local_of: NDArray[np.int64]
 
+    # A route is the target hops of the global search with one local segment (same target) or
+    # two (out of the first target to its Level-0, from the last target's Level-0 to the goal).
+    def route_points(
+        self, origin: NDArray[np.float64], hops: list[int], segments: list[NDArray[np.int64]]
+    ) -> tuple[NDArray[np.float64], float]:
+        """The route's metric path from ``origin``, via points included, and the summed weight
+        of its Target-layer edges."""
+        chunks = [origin[None, :], self.locals[hops[0]].points(segments[0])]
+        target_length = 0.0
+        for a, b in pairwise(hops):
+            edge = self.target_edges[(a, b)]
+            target_length += edge.weight
+            if edge.via is not None:
+                forward = self.target_ids[a] == edge.u
+                chunks.append(edge.via if forward else edge.via[::-1])
+            chunks.append(self.locals[b].csr.coords[:1])
+        if len(segments) > 1:
+            chunks.append(self.locals[hops[-1]].points(segments[1])[1:])
+        return np.concatenate(chunks), target_length
+
+    def route_nodes(
+        self, hops: list[int], segments: list[NDArray[np.int64]]
+    ) -> tuple[list[str], list[str], list[str]]:
+        """The ids of the route's traversable nodes in order: all of them, its levels, its
+        poses."""
+        visits = [(hops[0], segments[0].tolist()), *((b, [0]) for b in hops[1:])]
+        if len(segments) > 1:
+            visits.append((hops[-1], segments[1][1:].tolist()))
+        ids: list[str] = []
+        levels: list[str] = []
+        poses: list[str] = []
+        for target, local_nodes in visits:
+            names, n_levels = self.locals[target].node_ids, self.locals[target].n_levels
+            ids += [names[i] for i in local_nodes]
+            levels += [names[i] for i in local_nodes if i < n_levels]
+            poses += [names[i] for i in local_nodes if i >= n_levels]
+        return ids, levels, poses
+
 
 class HierarchicalPlanner:
     """Answers planning queries over a :class:`LayeredSemanticGraph`.
@@ -346,29 +384,8 @@ class HierarchicalPlanner:
         verb: Verb,
         query: str | None,
     ) -> RoutePlan:
-        visits = [(hops[0], segments[0].tolist())]
-        chunks = [origin[None, :], network.locals[hops[0]].points(segments[0])]
-        target_length = 0.0
-        for a, b in pairwise(hops):
-            edge = network.target_edges[(a, b)]
-            target_length += edge.weight
-            if edge.via is not None:
-                forward = network.target_ids[a] == edge.u
-                chunks.append(edge.via if forward else edge.via[::-1])
-            visits.append((b, [0]))
-            chunks.append(network.locals[b].csr.coords[:1])
-        if len(segments) > 1:
-            visits.append((hops[-1], segments[1][1:].tolist()))
-            chunks.append(network.locals[hops[-1]].points(segments[1])[1:])
-        ids: list[str] = []
-        levels: list[str] = []
-        poses: list[str] = []
-        for target, local_nodes in visits:
-            names, n_levels = network.locals[target].node_ids, network.locals[target].n_levels
-            ids += [names[i] for i in local_nodes]
-            levels += [names[i] for i in local_nodes if i < n_levels]
-            poses += [names[i] for i in local_nodes if i >= n_levels]
-        waypoints = np.concatenate(chunks)
+        waypoints, target_length = network.route_points(origin, hops, segments)
+        ids, levels, poses = network.route_nodes(hops, segments)
         t0, t1, t2, _ = timing
         return RoutePlan(
             goal_id=goal_node.id,

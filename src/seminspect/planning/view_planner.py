@@ -37,7 +37,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
-from seminspect.core.errors import InvalidInputError, PlanningError
+from seminspect.core.errors import PlanningError
 from seminspect.geometry.transforms import as_point, as_points
 
 UP = np.array([0.0, 0.0, 1.0])
@@ -130,18 +130,3 @@ def next_view_pose(
     heading = ahead - target
     yaw = math.atan2(heading[1], heading[0])  # eq (2), seen from the new pose
     return ViewPose(target, yaw, nearest, distance)
-
-
-def predict_view_path(
-    position: ArrayLike, surface: ArrayLike, constraints: ViewConstraints, horizon: int
-) -> list[ViewPose]:
-    """``Π_LVP``: eq (1) applied recursively over a prediction horizon (002 Sec III-C)."""
-    if horizon < 1:
-        raise InvalidInputError(f"prediction horizon must be >= 1, got {horizon}")
-    poses = []
-    here = as_point(position, "robot position")
-    for _ in range(horizon):
-        pose = next_view_pose(here, surface, constraints)
-        poses.append(pose)
-        here = pose.position
-    return poses

@@ -7,11 +7,16 @@ from collections.abc import Iterable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial.transform import Rotation
 
 from seminspect.core.params import InspectionParams
 from seminspect.core.rng import make_rng
-from seminspect.geometry.transforms import as_point, wrap_angle
+from seminspect.geometry.transforms import (
+    as_point,
+    quat_from_yaw_pitch,
+    reframe_points,
+    wrap_angle,
+    yaw_rotation,
+)
 from seminspect.platform.protocol import Motion
 from seminspect.robot import Robot
 from seminspect.robot.robot import MoveResult
@@ -113,8 +118,10 @@ class SimulatedPlatform:
     # ----------------------------------------------------------------- motion
     def _to_true(self, point: NDArray[np.float64]) -> NDArray[np.float64]:
         """Where the robot really goes when it aims for ``point`` in its odometry frame."""
-        rotate = Rotation.from_euler("z", self.robot.yaw - self.robot.odometry_yaw)
-        return rotate.apply(point - self.robot.odometry_position) + self.robot.position
+        robot = self.robot
+        return reframe_points(
+            point, robot.odometry_position, robot.odometry_yaw, robot.position, robot.yaw
+        )
 
     def move_to(self, point: ArrayLike, yaw: float | None = None) -> Motion:
         goal = as_point(point if len(np.ravel(point)) == 3 else [*np.ravel(point), 0.0])
@@ -137,8 +144,10 @@ class SimulatedPlatform:
 
     def _to_odometry(self, point: NDArray[np.float64]) -> NDArray[np.float64]:
         """The inverse of :meth:`_to_true`: a true point in the robot's odometry frame."""
-        rotate = Rotation.from_euler("z", self.robot.odometry_yaw - self.robot.yaw)
-        return rotate.apply(point - self.robot.position) + self.robot.odometry_position
+        robot = self.robot
+        return reframe_points(
+            point, robot.position, robot.yaw, robot.odometry_position, robot.odometry_yaw
+        )
 
     def turn_to(self, yaw: float) -> Motion:
         return self.move_to(self.position, yaw)
@@ -171,7 +180,7 @@ class SimulatedPlatform:
 
     def _camera_quaternion(self, yaw: float) -> NDArray[np.float64]:
         """The camera looks along the heading, tilted down by ``camera_pitch``."""
-        return Rotation.from_euler("ZY", [yaw, self.camera_pitch]).as_quat()
+        return quat_from_yaw_pitch(yaw, self.camera_pitch)
 
     def detect(self, frame: Frame, level: str, labels: Iterable[str]) -> list[Detection]:
         """Segment objects (``level="instance"``, by class) or parts (``"part"``, by part name)."""
@@ -202,8 +211,10 @@ class SimulatedPlatform:
             threads=self.threads,
         )
         self.scans += 1
-        turn = Rotation.from_euler("z", state.odometry_yaw - state.yaw)
-        scan.points = turn.apply(scan.points - state.position) + state.odometry_position
+        scan.points = reframe_points(
+            scan.points, state.position, state.yaw, state.odometry_position, state.odometry_yaw
+        )
+        turn = yaw_rotation(state.odometry_yaw - state.yaw)
         scan.misses = turn.apply(scan.misses.astype(np.float64)).astype(np.float32)
         scan.origin = state.odometry_position.copy()
         return scan

@@ -39,10 +39,11 @@ from seminspect.graphs.lsg.model import EdgeKind, FeatureNode, Layer, Node, Robo
 from seminspect.graphs.terrain.io import GRAPH_FORMAT as TERRAIN_FORMAT
 from seminspect.graphs.terrain.io import load_terrain_graph
 from seminspect.graphs.terrain.scene_graph import TerrainSceneGraph
+from seminspect.missions.xflie.layout import load_run_world, read_metrics_document
 from seminspect.report.lsg import LAYER_ORDER, layer_heights, lifted_position
 from seminspect.report.run_pictures import load_events, utility_series
 from seminspect.report.terrain import layer_lifts, prompt_colours, subsample_rows
-from seminspect.runs.directory import load_run_world, load_trajectory, read_metrics_document
+from seminspect.runs.trajectory import load_trajectory
 from seminspect.worlds import World
 
 REPORT_FILE = "report.html"

@@ -13,7 +13,7 @@ import math
 import os
 import re
 import statistics
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 
 from seminspect.core.errors import FileFormatError
@@ -116,3 +116,12 @@ def median_range(values: Iterable[float | None], digits: int = 0) -> str:
         f"{v:.{digits}f}" for v in (min(finite), statistics.median(finite), max(finite))
     )
     return middle if low == high else f"{middle} [{low}-{high}]"
+
+
+def seeds_cell(seeds: Sequence[int]) -> str:
+    """How a table names its seeds: ``0-4`` for a run of three or more, else ``0, 2``."""
+    seeds = sorted(seeds)
+    contiguous = seeds == list(range(seeds[0], seeds[-1] + 1))
+    return (
+        f"{seeds[0]}-{seeds[-1]}" if contiguous and len(seeds) > 2 else ", ".join(map(str, seeds))
+    )

@@ -21,7 +21,8 @@ from seminspect.mapping.voxel import OCCUPIED, load_map
 from seminspect.missions.routine.measures import change_masks
 from seminspect.missions.routine.run import PRIOR_FILE, TOUR_FORMAT
 from seminspect.report.figures import new_figure, save_figure
-from seminspect.runs.directory import load_trajectory, read_run_config
+from seminspect.runs.directory import read_run_config
+from seminspect.runs.trajectory import load_trajectory
 
 #: Heights drawn as M_H's walls in the change picture [m].
 WALL_BAND_M = (0.3, 4.0)

@@ -20,10 +20,11 @@ import numpy as np
 
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.io import load_graph
+from seminspect.missions.xflie.layout import load_run_world
 from seminspect.report.figures import new_figure, save_figure
 from seminspect.report.lsg import draw_layers
 from seminspect.report.worlds import draw_top_down
-from seminspect.runs.directory import load_robot_trajectories, load_run_world, load_trajectory
+from seminspect.runs.trajectory import load_robot_trajectories, load_trajectory
 from seminspect.worlds import World
 
 

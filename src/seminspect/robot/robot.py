@@ -24,10 +24,16 @@ from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial.transform import Rotation
 
 from seminspect.core.errors import InvalidInputError
-from seminspect.geometry.transforms import Quat, Vec3, as_point, quat_from_yaw, wrap_angle
+from seminspect.geometry.transforms import (
+    Quat,
+    Vec3,
+    as_point,
+    quat_from_yaw,
+    quat_from_yaw_pitch,
+    wrap_angle,
+)
 from seminspect.worlds import World
 
 Mode = Literal["ground", "aerial"]
@@ -215,7 +221,7 @@ class Robot:
 
     def camera_orientation(self, pitch: float = 0.0) -> Quat:
         """Camera quaternion: the body heading, tilted nose-down by ``pitch`` radians."""
-        return Rotation.from_euler("ZY", [self.yaw, pitch]).as_quat()
+        return quat_from_yaw_pitch(self.yaw, pitch)
 
     # ----------------------------------------------------------------- motion
     def move_to(self, point: ArrayLike, yaw: float | None = None) -> MoveResult:

@@ -247,6 +247,41 @@ def render(
     origin = as_point(position, "camera position")
     quat = as_quaternion(orientation, "camera orientation")
     model = camera.scaled(stride)
+    directions, distance, face = _cast_rays(world, model, origin, quat, threads)
+    depth, instance, class_id, part_id, grey = _shade_pixels(
+        world, model, origin, (directions, distance, face), threads=threads, intensity=intensity
+    )
+    shape = (model.height, model.width)
+    frame = Frame(
+        depth=depth.reshape(shape),
+        instance=instance.reshape(shape),
+        class_id=class_id.reshape(shape),
+        part_id=part_id.reshape(shape),
+        intensity=None if grey is None else grey.reshape(shape),
+        face=face.reshape(shape),
+        position=origin,
+        orientation=quat,
+        stamp=float(stamp),
+        camera=model,
+        odometry_position=origin
+        if odometry is None
+        else as_point(odometry[0], "odometry position"),
+        odometry_orientation=quat
+        if odometry is None
+        else as_quaternion(odometry[1], "odometry orientation"),
+    )
+    if noise is not None and not noise.is_ideal:
+        _add_image_noise(frame, noise, rng if isinstance(rng, NormalStream) else require_rng(rng))
+    return frame
+
+
+#: Per pixel (row-major): the ray's world-frame direction, the distance to what it hits and
+#: that face's index (-1: nothing within range).
+_Hits = tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.int32]]
+
+
+def _cast_rays(world: World, model: CameraModel, origin: Vec3, quat: Quat, threads: int) -> _Hits:
+    """Cast every pixel's ray from the camera pose ``(origin, quat)``."""
     directions_body, cosine = model.rays
     count = len(cosine)
     directions, distance = _scratch(count)
@@ -259,6 +294,28 @@ def render(
         threads,
         out=(distance, np.empty(count, dtype=np.int32)),
     )
+    return directions, distance, face
+
+
+def _shade_pixels(
+    world: World,
+    model: CameraModel,
+    origin: Vec3,
+    hits: _Hits,
+    *,
+    threads: int,
+    intensity: bool,
+) -> tuple[
+    NDArray[np.float32],
+    NDArray[np.int32],
+    NDArray[np.int16],
+    NDArray[np.int16],
+    NDArray[np.uint8] | None,
+]:
+    """The flat depth, instance, class, part and (with ``intensity``) grey images of the hits."""
+    directions, distance, face = hits
+    cosine = model.rays[1]
+    count = len(cosine)
     depth = np.empty(count, dtype=np.float32)
     instance = np.empty(count, dtype=np.int32)
     class_id = np.empty(count, dtype=np.int16)
@@ -292,28 +349,7 @@ def render(
 
     # Pixels shade independently, so they may be dealt out over threads.
     run_dealt(shade, count, threads, MIN_PIXELS_PER_THREAD)
-    shape = (model.height, model.width)
-    frame = Frame(
-        depth=depth.reshape(shape),
-        instance=instance.reshape(shape),
-        class_id=class_id.reshape(shape),
-        part_id=part_id.reshape(shape),
-        intensity=grey.reshape(shape) if intensity else None,
-        face=face.reshape(shape),
-        position=origin,
-        orientation=quat,
-        stamp=float(stamp),
-        camera=model,
-        odometry_position=origin
-        if odometry is None
-        else as_point(odometry[0], "odometry position"),
-        odometry_orientation=quat
-        if odometry is None
-        else as_quaternion(odometry[1], "odometry orientation"),
-    )
-    if noise is not None and not noise.is_ideal:
-        _add_image_noise(frame, noise, rng if isinstance(rng, NormalStream) else require_rng(rng))
-    return frame
+    return depth, instance, class_id, part_id, grey if intensity else None
 
 
 _SCRATCH = threading.local()

@@ -74,9 +74,8 @@ def shade_hits(  # noqa: PLR0917 - a compiled kernel takes its arrays positional
     and value and hashes only when the cell changes (the same values, fewer hashes).
     """
     grey = intensity.shape[0] > 0
-    last_ix = np.zeros(octaves.shape[0], dtype=np.int64)
-    last_iy = np.zeros(octaves.shape[0], dtype=np.int64)
-    last_seed = np.full(octaves.shape[0], -1, dtype=np.int64)  # seeds are >= 0: no match
+    last_cell = np.zeros((octaves.shape[0], 3), dtype=np.int64)  # ix, iy and seed per octave
+    last_cell[:, 2] = -1  # seeds are >= 0: no match
     last_value = np.zeros(octaves.shape[0])
     for i in range(distance.shape[0]):
         f = face[i]
@@ -99,23 +98,47 @@ def shade_hits(  # noqa: PLR0917 - a compiled kernel takes its arrays positional
         b = plane_axes[f, 1]
         u = origin[a] + t * directions[i, a]
         v = origin[b] + t * directions[i, b]
-        footprint = 2.0 * t * pixel_angle
-        texture = 0.0
-        for k in range(octaves.shape[0]):
-            cell = octaves[k]
-            if cell < footprint:
-                texture += weights[k] * 0.5
-            else:
-                ix = int(np.floor(u / cell))
-                iy = int(np.floor(v / cell))
-                seed = plane_seed[f] + k
-                if ix != last_ix[k] or iy != last_iy[k] or seed != last_seed[k]:
-                    last_ix[k], last_iy[k], last_seed[k] = ix, iy, seed
-                    last_value[k] = _hash(ix, iy, seed)
-                texture += weights[k] * last_value[k]
-        cosine = abs(light[f])
-        value = 255.0 * albedo[f] * (0.35 + 0.65 * cosine) * (0.45 + 0.55 * texture)
-        intensity[i] = np.uint8(min(255.0, value))
+        texture = _texture(
+            u, v, 2.0 * t * pixel_angle, plane_seed[f], octaves, weights, last_cell, last_value
+        )
+        intensity[i] = _grey_level(albedo[f], light[f], texture)
+
+
+@numba.njit(cache=True, inline="always")
+def _texture(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
+    u: float,
+    v: float,
+    footprint: float,
+    plane_seed: int,
+    octaves: np.ndarray,
+    weights: np.ndarray,
+    last_cell: np.ndarray,
+    last_value: np.ndarray,
+) -> float:
+    """The value noise at ``(u, v)`` on a face plane, in [0, 1): octaves whose cells are
+    smaller than the pixel ``footprint`` count at their mean. ``last_cell`` and ``last_value``
+    hold each octave's last cell and its value, updated here."""
+    texture = 0.0
+    for k in range(octaves.shape[0]):
+        cell = octaves[k]
+        if cell < footprint:
+            texture += weights[k] * 0.5
+        else:
+            ix = int(np.floor(u / cell))
+            iy = int(np.floor(v / cell))
+            seed = plane_seed + k
+            if ix != last_cell[k, 0] or iy != last_cell[k, 1] or seed != last_cell[k, 2]:
+                last_cell[k, 0], last_cell[k, 1], last_cell[k, 2] = ix, iy, seed
+                last_value[k] = _hash(ix, iy, seed)
+            texture += weights[k] * last_value[k]
+    return texture
+
+
+@numba.njit(cache=True, inline="always")
+def _grey_level(albedo: float, sun_cosine: float, texture: float) -> np.uint8:
+    """Lambert shading, two-sided, with ambient light, over the albedo and texture."""
+    value = 255.0 * albedo * (0.35 + 0.65 * abs(sun_cosine)) * (0.45 + 0.55 * texture)
+    return np.uint8(min(255.0, value))
 
 
 def surface_tables(world: World) -> tuple[NDArray, ...]:

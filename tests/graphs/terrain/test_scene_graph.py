@@ -142,4 +142,4 @@ def test_places_are_scored_against_true_patches(build) -> None:
     assert score_places(cut, "sidewalk", [sidewalk]).connected == 0
     absent = score_places(scene, "sidewalk", [])
     assert absent.patches == 0 and absent.off_terrain == len(mine)
-    assert absent.as_dict()["worst_offset"] is None  # infinite: no such terrain at all
+    assert absent.to_json()["worst_offset"] is None  # infinite: no such terrain at all

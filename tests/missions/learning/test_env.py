@@ -1,4 +1,4 @@
-"""The 004 environment: reward terms by hand, the ego frame, determinism, sensors, env checker."""
+"""The 004 environment: the ego frame, determinism, the pruned camera rays, the env checker."""
 
 import math
 
@@ -6,58 +6,9 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-from seminspect.missions.learning.env import (
-    EnvConfig,
-    InspectionEnv,
-    InspectionVectorEnv,
-    _camera_rays,
-    _sensor_rays,
-    face_scores,
-    semantic_search_reward,
-    spatial_visit_scores,
-)
-
-D_REF, ALPHA, BETA = 1.5, 0.15, 1.0
-
-
-def _scores(distance, best):
-    return face_scores(np.array([distance]), np.array([best]), D_REF, ALPHA, BETA)
-
-
-def test_a_face_first_seen_at_d_ref_scores_alpha():
-    score, best = _scores(D_REF, np.inf)
-    assert score[0] == pytest.approx(ALPHA)
-    assert best[0] == D_REF
-
-
-def test_a_farther_later_view_scores_nothing_and_keeps_d_f():
-    score, best = _scores(D_REF + 1.0, D_REF)
-    assert score[0] == 0.0 and best[0] == D_REF
-    score, best = _scores(np.nan, D_REF)  # not in view this step
-    assert score[0] == 0.0 and best[0] == D_REF
-
-
-def test_a_view_closer_to_d_ref_scores_again_and_updates_d_f():
-    score, best = _scores(D_REF + 0.5, D_REF + 1.0)
-    assert score[0] == pytest.approx(ALPHA * math.exp(-BETA * 0.25))
-    assert best[0] == D_REF + 0.5
-    # equally far on the other side of d_ref is not closer: eq (7) needs strictly less
-    score, _ = _scores(D_REF - 1.0, D_REF + 1.0)
-    assert score[0] == 0.0
-
-
-def test_spatial_visit_scores_are_eq_3_on_a_known_histogram():
-    scores, totals = spatial_visit_scores(np.array([[1, 1, 2, 0], [0, 0, 0, 0]]))
-    p = np.array([0.25, 0.25, 0.5])
-    np.testing.assert_allclose(scores[0, :3], -p * np.log(p), rtol=1e-6)
-    assert scores[0, 3] == 0.0 and not scores[1].any()
-    np.testing.assert_array_equal(totals, [4.0, 0.0])
-
-
-def test_semantic_search_reward_is_eq_10():
-    reward = semantic_search_reward(np.array([0, 10, 100]), gamma=0.005, delta=0.02)
-    np.testing.assert_allclose(reward, 0.005 * np.exp(-0.02 * np.array([0, 10, 100])))
-    assert reward[0] == 0.005 and reward[2] < reward[1] < reward[0]
+from seminspect.geometry.transforms import rotate_xy
+from seminspect.missions.learning.env import EnvConfig, InspectionEnv, InspectionVectorEnv
+from seminspect.missions.learning.sensors import camera_rays, sensor_rays
 
 
 @pytest.fixture(scope="module")
@@ -127,11 +78,9 @@ def test_masked_depth_is_the_full_render_on_target_pixels_only(empty_room_env):
     env._sense(np.array([0]))
     depth = env._obs["depth"][0, 0].reshape(-1)
     # every pixel cast by hand
-    camera, cosines = _camera_rays(cfg)
-    c, s = math.cos(env._yaw[0]), math.sin(env._yaw[0])
-    world = np.column_stack(
-        [c * camera[:, 0] - s * camera[:, 1], s * camera[:, 0] + c * camera[:, 1], camera[:, 2]]
-    )
+    camera, cosines = camera_rays(cfg.image_size, cfg.fov_deg)
+    turned = rotate_xy(math.cos(env._yaw[0]), math.sin(env._yaw[0]), camera[:, 0], camera[:, 1])
+    world = np.column_stack([*turned, camera[:, 2]])
     distance, tri = env._caster.cast(env._position[0], world, cfg.camera_range)
     on_target = (tri >= 0) & (env._face_of_triangle[np.maximum(tri, 0)] >= 0)
     assert on_target.sum() > 100  # the target fills part of the view
@@ -139,7 +88,7 @@ def test_masked_depth_is_the_full_render_on_target_pixels_only(empty_room_env):
     expected = distance[on_target] * cosines[on_target] / cfg.camera_range
     np.testing.assert_allclose(depth[on_target], expected, atol=0.02)  # range noise only
     # the pruned ray set keeps every target pixel
-    _, ray, _, _ = _sensor_rays(
+    _, ray, _, _ = sensor_rays(
         env._position[:1],
         env._yaw[:1],
         env._camera,

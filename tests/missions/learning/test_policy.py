@@ -183,7 +183,7 @@ def test_the_small_preset_is_small() -> None:
 
 def test_importing_the_package_does_not_load_torch() -> None:
     code = "import sys, seminspect.missions.learning; assert 'torch' not in sys.modules"
-    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2] / "src")}
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[3] / "src")}
     subprocess.run([sys.executable, "-c", code], check=True, env=env)
 
 

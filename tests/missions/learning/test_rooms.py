@@ -14,6 +14,7 @@ from seminspect.missions.learning.rooms import (
     Solids,
     clearance,
     sample_room,
+    side_by_side,
     stack_solids,
 )
 
@@ -87,3 +88,15 @@ def test_bad_rooms_are_refused():
         sample_room(np.random.default_rng(0), -1)
     with pytest.raises(InvalidInputError, match="at least 4 x 4 x 2"):
         sample_room(np.random.default_rng(0), 0, size=(3.0, 10.0, 4.0))
+
+
+def test_rooms_side_by_side_keep_their_own_triangles_and_faces():
+    rooms = [sample_room(np.random.default_rng(seed), 2) for seed in (0, 1)]
+    vertices, triangles, faces = side_by_side(rooms, 12.0)
+    first = len(rooms[0].vertices)
+    np.testing.assert_array_equal(vertices[first:], rooms[1].vertices + np.array([12.0, 0.0, 0.0]))
+    np.testing.assert_array_equal(triangles[len(rooms[0].triangles) :], rooms[1].triangles + first)
+    np.testing.assert_array_equal(faces, np.concatenate([r.face_of_triangle for r in rooms]))
+    batch = stack_solids(rooms)
+    one = batch.rows(np.array([1]))
+    np.testing.assert_array_equal(one.centre[0, :3], rooms[1].solids.centre)

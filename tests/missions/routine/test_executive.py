@@ -5,10 +5,11 @@ import pytest
 
 from seminspect.core.io import read_versioned_json
 from seminspect.mapping.voxel import OCCUPIED, VoxelMap, load_map
-from seminspect.missions.routine.executive import RoutineConfig, _checkpoints, leg_slack
+from seminspect.missions.routine.config import RoutineConfig
+from seminspect.missions.routine.executive import _checkpoints, leg_slack
+from seminspect.missions.routine.metrics import read_routine_metrics
 from seminspect.missions.routine.run import PRIOR_FILE, run_routine
 from seminspect.planning.global_views import pose_is_clear
-from seminspect.runs.directory import read_metrics_document
 
 SMALL = {"scenario": "receding", "seed": 1, "length": 12.0}
 
@@ -29,22 +30,22 @@ def baseline(tmp_path_factory, adaptive):
 def test_adaptive_run_completes_and_keeps_the_viewing_distance(adaptive):
     m = adaptive.metrics
     assert adaptive.state == "completed"
-    assert m["tasks_completed"] == m["tasks_total"] == 1
-    assert m["collisions"] == 0
-    assert m["gamma_s_max"] > 0.5 and m["adapted_cycles"] > 0
-    assert m["view_distance_mae_after_deviation_m"] < 0.3
-    assert m["rmse_after_kabsch_m"] < m["rmse_before_kabsch_m"]
-    assert m["roi_coverage_pct"] > 50
-    assert 0 < m["viewpoint_utility_mean"] <= 1
-    assert read_metrics_document(adaptive.run_dir)["tasks_completed"] == 1
+    assert m.tasks_completed == m.tasks_total == 1
+    assert m.collisions == 0
+    assert m.gamma_s_max > 0.5 and m.adapted_cycles > 0
+    assert m.view_distance_mae_after_deviation_m < 0.3
+    assert m.rmse_after_kabsch_m < m.rmse_before_kabsch_m
+    assert m.roi_coverage_pct > 50
+    assert 0 < m.viewpoint_utility_mean <= 1
+    assert read_routine_metrics(adaptive.run_dir) == adaptive.metrics
 
 
 def test_baseline_tracks_the_outdated_plan_and_sees_less(adaptive, baseline):
     a, b = adaptive.metrics, baseline.metrics
-    assert b["adapted_cycles"] == 0
-    assert b["view_distance_mae_m"] > a["view_distance_mae_m"] + 0.5
-    assert b["roi_coverage_pct"] < a["roi_coverage_pct"]
-    assert b["viewpoint_utility_mean"] < a["viewpoint_utility_mean"]
+    assert b.adapted_cycles == 0
+    assert b.view_distance_mae_m > a.view_distance_mae_m + 0.5
+    assert b.roi_coverage_pct < a.roi_coverage_pct
+    assert b.viewpoint_utility_mean < a.viewpoint_utility_mean
 
 
 def test_run_directory_holds_both_maps_the_tour_and_the_time_series(adaptive):
@@ -52,12 +53,12 @@ def test_run_directory_holds_both_maps_the_tour_and_the_time_series(adaptive):
     prior, current = load_map(root / PRIOR_FILE), load_map(root / "map.npz")
     assert prior.states.shape == current.states.shape
     tour = read_versioned_json(root / "tour.json", "seminspect.routine-tour", [1])["tasks"][0]
-    assert len(tour["views"]) == adaptive.metrics["cycles"]
+    assert len(tour["views"]) == adaptive.metrics.cycles
     assert tour["sa_length_m"] > 0
     lines = (root / "views.csv").read_text().splitlines()
-    assert lines[0].startswith("t,task,k,") and len(lines) == adaptive.metrics["cycles"] + 1
-    change = adaptive.metrics["change_report"][0]
-    assert change["removed_m3"] > 0.1  # the block in front of the face is gone
+    assert lines[0].startswith("t,task,k,") and len(lines) == adaptive.metrics.cycles + 1
+    change = adaptive.metrics.change_report[0]
+    assert change.removed_m3 > 0.1  # the block in front of the face is gone
 
 
 def test_ctrl_c_leaves_a_truthful_run_directory(tmp_path, adaptive):
@@ -71,15 +72,15 @@ def test_ctrl_c_leaves_a_truthful_run_directory(tmp_path, adaptive):
     )
     status = read_versioned_json(tmp_path / "cut" / "status.json", "seminspect.run-status", [1])
     assert result.state == status["state"] == "interrupted"
-    metrics = read_metrics_document(tmp_path / "cut")
-    assert metrics["tasks_completed"] == 0 and 0 < metrics["cycles"] < adaptive.metrics["cycles"]
+    metrics = read_routine_metrics(tmp_path / "cut")
+    assert metrics.tasks_completed == 0 and 0 < metrics.cycles < adaptive.metrics.cycles
 
 
 def test_nominal_site_never_crosses_the_threshold(adaptive, tmp_path):
     config = RoutineConfig(scenario="nominal", seed=1, length=12.0)
     result = run_routine(config, tmp_path / "nominal")
-    assert result.metrics["gamma_s_max"] < config.gamma_t
-    assert result.metrics["adapted_cycles"] == 0
+    assert result.metrics.gamma_s_max < config.gamma_t
+    assert result.metrics.adapted_cycles == 0
 
 
 def test_checkpoints_cut_a_route_every_segment():
@@ -91,7 +92,7 @@ def test_checkpoints_cut_a_route_every_segment():
 def test_priors_load_from_maps_and_point_clouds(tmp_path, adaptive):
     from seminspect.core.errors import FileFormatError
     from seminspect.mapping.voxel import OCCUPIED
-    from seminspect.missions.routine.executive import load_prior
+    from seminspect.missions.routine.prior import load_prior
 
     again = load_prior(adaptive.run_dir / PRIOR_FILE, 0.1)
     assert again.counts() == load_map(adaptive.run_dir / PRIOR_FILE).counts()
@@ -110,7 +111,7 @@ def test_priors_load_from_maps_and_point_clouds(tmp_path, adaptive):
 def test_an_octomap_prior_loads(shared_data):
     pytest.importorskip("pyoctomap")
     from seminspect.mapping.formats.octomap import load_octomap
-    from seminspect.missions.routine.executive import load_prior
+    from seminspect.missions.routine.prior import load_prior
 
     path = shared_data / "octomap" / "geb079.bt"
     assert load_prior(path, 0.16).counts() == load_octomap(path, 0.16).counts()
@@ -119,9 +120,9 @@ def test_an_octomap_prior_loads(shared_data):
 def test_pins_the_nominal_row_of_the_reproduction_doc(tmp_path):
     """docs/reproduction.md, 002 nominal: Γ_s max 0.23, utility 0.845, coverage 99.2 %."""
     m = run_routine(RoutineConfig(scenario="nominal", seed=0), tmp_path / "nominal").metrics
-    assert m["gamma_s_max"] == pytest.approx(0.23, abs=0.005)
-    assert m["viewpoint_utility_mean"] == pytest.approx(0.845, abs=0.0005)
-    assert m["roi_coverage_pct"] == pytest.approx(99.2, abs=0.05)
+    assert m.gamma_s_max == pytest.approx(0.23, abs=0.005)
+    assert m.viewpoint_utility_mean == pytest.approx(0.845, abs=0.0005)
+    assert m.roi_coverage_pct == pytest.approx(99.2, abs=0.05)
 
 
 def test_a_point_the_planner_calls_clear_passes_the_leg_check_with_its_slack() -> None:

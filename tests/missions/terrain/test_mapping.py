@@ -119,15 +119,23 @@ def test_quality_on_the_small_world_meets_the_targets(world, mapped, fake_encode
     run, _ = mapped
     build = build_terrain_graph(run.cloud, PROMPTS, fake_encoder, calibration=CALIBRATION)
     quality = evaluate_on_world(build, world, fake_encoder)
-    cars, trees = quality["objects"]["image of a car"], quality["objects"]["image of a tree"]
-    assert cars["ground_truth_class"] == "car" and cars["ground_truth"] == 2
-    assert cars["precision"] >= 0.9 and cars["recall"] >= 0.9 and cars["mean_iou"] > 0.5
-    assert trees["ground_truth"] == 2 and trees["precision"] >= 0.9 and trees["recall"] >= 0.9
+    cars, trees = quality.objects["image of a car"], quality.objects["image of a tree"]
+    assert cars.match.truth == "car" and cars.scores is not None and trees.scores is not None
+    assert cars.scores.ground_truth == 2 and cars.scores.mean_iou > 0.5
+    assert cars.scores.precision >= 0.9 and cars.scores.recall >= 0.9
+    assert trees.scores.ground_truth == 2
+    assert trees.scores.precision >= 0.9 and trees.scores.recall >= 0.9
     for terrain in PROMPTS.terrain:
-        places = quality["places"][terrain]
-        assert places["ground_truth_class"] == terrain and places["patches"] >= 1
-        assert places["points_on_terrain"] > 0.97
-        assert places["all_connected"] and places["off_terrain"] == 0, places
+        places = quality.places[terrain]
+        assert places.match.truth == terrain and places.scores.patches >= 1
+        assert places.points_on_terrain is not None and places.points_on_terrain > 0.97
+        assert places.scores.all_connected and places.scores.off_terrain == 0, places
+    record = quality.to_json()  # the summary.json record: flat per prompt
+    assert record["objects"]["image of a car"] == {
+        **cars.match.to_json(),
+        **cars.scores.to_json(),
+    }
+    assert list(record["places"]["sidewalk"])[3:5] == ["points_on_terrain", "terrain"]
 
 
 @pytest.mark.slow

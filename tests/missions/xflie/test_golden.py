@@ -36,7 +36,7 @@ from seminspect.missions.xflie.run import run_mission
 from seminspect.report.markdown import mean_sd, median_range
 
 GOLDEN_DIR = Path(__file__).parent / "data" / "golden"
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 DOCS = REPO / "docs" / "reproduction.md"
 #: The golden configuration: the city small mission, seed 0, every other setting default.
 CONFIG = {"world": "city", "scenario": "small", "seed": 0}

@@ -6,8 +6,9 @@ from scipy.spatial.transform import Rotation
 
 from seminspect.core.errors import InvalidInputError
 from seminspect.mapping.formats.rosbag import read_bag_scans, read_label_names
+from seminspect.missions.xflie.layout import load_run_world
 from seminspect.missions.xflie.replay import export_run_bag, sampled_rows
-from seminspect.runs.directory import load_run_world, load_trajectory
+from seminspect.runs.trajectory import load_trajectory
 from seminspect.sensors.lidar import Lidar
 
 pytest.importorskip("rosbags", reason="the 'ros' extra (rosbags) is not installed")

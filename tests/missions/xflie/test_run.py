@@ -12,12 +12,12 @@ from seminspect.core.io import read_versioned_json
 from seminspect.graphs.lsg.io import load_graph
 from seminspect.graphs.lsg.model import EdgeKind
 from seminspect.mapping.voxel import FREE, load_map
-from seminspect.missions.xflie import XFlie
+from seminspect.missions.xflie import XFlie, outputs
 from seminspect.missions.xflie.config import make_config
 from seminspect.missions.xflie.metrics import MissionMetrics
 from seminspect.missions.xflie.run import run_mission
 from seminspect.planning.hierarchical import HierarchicalPlanner
-from seminspect.runs.directory import RunDirectory, load_trajectory
+from seminspect.runs.trajectory import load_trajectory
 
 pytestmark = pytest.mark.slow
 
@@ -165,10 +165,10 @@ def test_the_volumetric_baseline_mission_plans_with_charged_time(tmp_path: Path)
 
 
 def test_a_ctrl_c_while_writing_outputs_is_not_reported_as_completed(tmp_path, monkeypatch) -> None:
-    def interrupted_write(self, occupancy) -> None:
+    def interrupted_write(path, occupancy) -> None:
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(RunDirectory, "write_map", interrupted_write)
+    monkeypatch.setattr(outputs, "save_map", interrupted_write)
     config = make_config({"world": "subterranean", "time_budget_s": 10})
     result = run_mission(config, tmp_path / "run")
     status = read_versioned_json(tmp_path / "run" / "status.json", "seminspect.run-status", [1])

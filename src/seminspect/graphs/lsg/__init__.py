@@ -1,6 +1,6 @@
 """The 3D Layered Semantic Graph of 000 Sec IV: Target -> Level -> Pose -> Feature."""
 
-from seminspect.graphs.lsg.graph import LayeredSemanticGraph, PopulationStats
+from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.io import export_graphml, export_spark_dsg, load_graph, save_graph
 from seminspect.graphs.lsg.model import (
     Edge,
@@ -14,6 +14,7 @@ from seminspect.graphs.lsg.model import (
     TargetStatus,
 )
 from seminspect.graphs.lsg.networkx_view import to_networkx, traversable_networkx
+from seminspect.graphs.lsg.population import PopulationStats
 from seminspect.graphs.lsg.synthetic import synthetic_graph
 
 __all__ = [

@@ -16,13 +16,15 @@ operator               what it registers                           paper
 ``close_level``        Φ on ``G~^PF``, then the union              eq (10)
 ``finish_inspection``  containment polygon, centroid refinement    Sec V-B
 =====================  ==========================================  =============
+
+What each operator makes of an observation is in :mod:`.registration`, the union in
+:mod:`.union`, and the Table 3 statistics in :mod:`.population`.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, field
 from typing import TypeVar
 
 import numpy as np
@@ -31,12 +33,7 @@ from numpy.typing import ArrayLike, NDArray
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.names import unknown_name
 from seminspect.core.params import PRESETS, InspectionParams
-from seminspect.geometry.polygons import (
-    hull_polygon,
-    polygon_centroid,
-    polygon_contains,
-    ring_polygon,
-)
+from seminspect.geometry.polygons import ring_polygon
 from seminspect.geometry.transforms import IDENTITY_QUAT, as_point, as_quaternion, yaw_from_quat
 from seminspect.graphs.lsg import naming
 from seminspect.graphs.lsg.claims import TargetClaims
@@ -57,96 +54,25 @@ from seminspect.graphs.lsg.optimisation import (
     ExistingTarget,
     InspectedView,
     Outcome,
-    PoseFeaturePair,
-    TargetDecision,
-    optimise_features,
     optimise_targets,
 )
+from seminspect.graphs.lsg.population import LayerPopulation, PopulationStats
+from seminspect.graphs.lsg.registration import (
+    Inspection,
+    LevelSummary,
+    TargetUpdate,
+    covered_targets,
+    enclose_target,
+    kept_features,
+    merge_detection,
+    new_level,
+    new_pose,
+    new_target,
+)
+from seminspect.graphs.lsg.union import UnifiedGraph
 from seminspect.perception.observation import Observation
 
 N = TypeVar("N", bound=Node)
-
-
-@dataclass(frozen=True, slots=True)
-class LayerPopulation:
-    """Nodes and edges summed over the local graphs of one layer."""
-
-    nodes: int
-    edges: int
-
-    def __str__(self) -> str:
-        return f"{self.nodes}/{self.edges}"
-
-
-@dataclass(frozen=True, slots=True)
-class PopulationStats:
-    """The graph columns of 000 Table 3.
-
-    ``reconciled_pct`` is the share of local-graph node registrations that the union merged into
-    a node already present: ``100 * (sum of local nodes - unified nodes) / sum of local nodes``.
-    A node is counted once per local graph it belongs to (a level is a child in its target's
-    Level graph and the parent of its Pose graph), so the union reconciles exactly the parents.
-    """
-
-    target: LayerPopulation
-    level: LayerPopulation
-    pose: LayerPopulation
-    feature: LayerPopulation
-    unified: LayerPopulation
-    targets_detected: int
-    targets_inspected: int
-
-    @property
-    def total(self) -> LayerPopulation:
-        layers = (self.target, self.level, self.pose, self.feature)
-        return LayerPopulation(sum(p.nodes for p in layers), sum(p.edges for p in layers))
-
-    @property
-    def reconciled_pct(self) -> float:
-        total = self.total.nodes
-        return 100.0 * (total - self.unified.nodes) / total if total else 0.0
-
-
-@dataclass(frozen=True, slots=True)
-class TargetUpdate:
-    """What one application of eq (4) + (5) did."""
-
-    decisions: tuple[TargetDecision, ...]
-    #: Node id for each candidate: the node it became or merged into; None when rejected.
-    resolved: tuple[str | None, ...]
-
-    def count(self, outcome: Outcome) -> int:
-        return sum(1 for d in self.decisions if d.outcome is outcome)
-
-    @property
-    def added(self) -> list[str]:
-        return [
-            r
-            for d, r in zip(self.decisions, self.resolved, strict=True)
-            if d.outcome is Outcome.ADDED and r
-        ]
-
-
-@dataclass(frozen=True, slots=True)
-class LevelSummary:
-    """What closing a level (eq (10)) did."""
-
-    level_id: str
-    registered: int
-    kept: tuple[str, ...]
-
-    @property
-    def pruned(self) -> int:
-        return self.registered - len(self.kept)
-
-
-@dataclass(slots=True)
-class _Inspection:
-    """The inspection in progress: its target, current level and interim ``G~^PF``."""
-
-    target: TargetNode
-    level: LevelNode
-    interim: list[PoseFeaturePair] = field(default_factory=list)
 
 
 class LayeredSemanticGraph:
@@ -170,10 +96,10 @@ class LayeredSemanticGraph:
             as_quaternion(robot_orientation, "robot orientation"),
         )
         self.target_graph = LocalGraph(Layer.TARGET, self.robot)
-        self._nodes: dict[str, Node] = {self.robot.id: self.robot}
-        self._edges: dict[tuple[str, str], Edge] = {}
+        #: The unified graph ``G_k``, the union of every local graph.
+        self.unified = UnifiedGraph(self.robot)
         self._pending: list[Observation] = []
-        self._inspection: _Inspection | None = None
+        self._inspection: Inspection | None = None
         #: Detected targets removed by the last :meth:`finish_inspection`.
         self.pruned: tuple[str, ...] = ()
         self.next_target_index = 0
@@ -184,25 +110,25 @@ class LayeredSemanticGraph:
 
     # ------------------------------------------------------------------ access
     def __contains__(self, node_id: object) -> bool:
-        return node_id in self._nodes
+        return node_id in self.unified.nodes
 
     def node(self, node_id: str) -> Node:
         """The node with this id (``car-1``, ``car-1/Level-0/hood-1``, ``robot``)."""
         try:
-            return self._nodes[node_id]
+            return self.unified.nodes[node_id]
         except KeyError:
-            raise unknown_name("node", node_id, self._nodes) from None
+            raise unknown_name("node", node_id, self.unified.nodes) from None
 
     def nodes(self) -> Iterator[Node]:
         """Every node of the unified graph."""
-        return iter(self._nodes.values())
+        return iter(self.unified.nodes.values())
 
     def edges(self) -> Iterator[Edge]:
         """Every edge of the unified graph."""
-        return iter(self._edges.values())
+        return iter(self.unified.edges.values())
 
     def edge(self, u: str, v: str) -> Edge | None:
-        return self._edges.get((u, v) if u <= v else (v, u))
+        return self.unified.edges.get((u, v) if u <= v else (v, u))
 
     def targets(self, status: TargetStatus | None = None) -> list[TargetNode]:
         """Target nodes in registration order, optionally only those of one status."""
@@ -214,7 +140,7 @@ class LayeredSemanticGraph:
 
     def target(self, name: str) -> TargetNode:
         """The target called ``name`` (case-insensitive); unknown names suggest close ones."""
-        node = self._nodes.get(name)
+        node = self.unified.nodes.get(name)
         if not isinstance(node, TargetNode):
             lowered = {t.id.lower(): t for t in self.targets()}
             node = lowered.get(name.lower())
@@ -282,9 +208,9 @@ class LayeredSemanticGraph:
                 into = decision.target_id
                 if decision.into_candidate is not None:
                     into = resolved[decision.into_candidate]
-                target = self._nodes[into]  # type: ignore[index]
+                target = self.unified.nodes[into]  # type: ignore[index]
                 assert isinstance(target, TargetNode)
-                self._merge_detection(target, candidates[i])
+                merge_detection(target, candidates[i])
                 resolved[i] = into
         if candidates:
             self.revision += 1
@@ -293,28 +219,7 @@ class LayeredSemanticGraph:
     def _add_target(self, z: Observation) -> TargetNode:
         index = self.next_target_index
         self.next_target_index += 1
-        target = TargetNode(
-            id=naming.target_name(z.label, index),
-            label=z.label,
-            index=index,
-            position=z.position.copy(),
-            score=z.score,
-            mask_area=z.mask_area,
-            image=z.image,
-            stamp=z.stamp,
-        )
-        return self.add_target(target)
-
-    @staticmethod
-    def _merge_detection(target: TargetNode, z: Observation) -> None:
-        """A duplicate detection: the larger mask (closer, fuller view) sets the attributes."""
-        target.observations += 1
-        if z.mask_area > target.mask_area and not target.inspected:
-            target.position = z.position.copy()
-            target.score = z.score
-            target.mask_area = z.mask_area
-            target.image = z.image
-            target.stamp = z.stamp
+        return self.add_target(new_target(z, index))
 
     def discard_target(self, target_id: str) -> TargetNode:
         """Remove a detected (uninspected) target found to be invalid, e.g. a false detection
@@ -324,11 +229,7 @@ class LayeredSemanticGraph:
             raise InvalidInputError(
                 f"{target.id} is inspected; only detected targets are discarded"
             )
-        for key in [k for k in self.target_graph.edges if target.id in k]:
-            del self.target_graph.edges[key]
-            del self._edges[key]
-        del self.target_graph.nodes[target.id]
-        del self._nodes[target.id]
+        self.unified.discard(self.target_graph, target.id)
         self.revision += 1
         return target
 
@@ -347,7 +248,7 @@ class LayeredSemanticGraph:
         if first is second:
             raise InvalidInputError(f"cannot connect {first.id} to itself")
         ends = (self.entry_level(first).position, self.entry_level(second).position)
-        edge = self._link(self.target_graph, first, second, via, ends)
+        edge = self.unified.link(self.target_graph, first, second, via, ends)
         self.revision += 1
         return edge
 
@@ -377,7 +278,7 @@ class LayeredSemanticGraph:
             raise InvalidInputError(f"{target.id} is already inspected")
         target.level_graph = LocalGraph(Layer.LEVEL, target)
         level = self._new_level(target, z)
-        self._inspection = _Inspection(target, level)
+        self._inspection = Inspection(target, level)
         return level
 
     def begin_level(self, z: Observation, via: ArrayLike | None = None) -> LevelNode:
@@ -395,16 +296,7 @@ class LayeredSemanticGraph:
     def _new_level(
         self, target: TargetNode, z: Observation, via: ArrayLike | None = None
     ) -> LevelNode:
-        index = len(target.levels)
-        level = LevelNode(
-            id=naming.join(target.id, naming.level_name(index)),
-            name=naming.level_name(index),
-            index=index,
-            target_id=target.id,
-            position=z.position.copy(),
-            stamp=z.stamp,
-        )
-        self.add_level(level, via)
+        level = self.add_level(new_level(target, z), via)
         self.revision += 1
         return level
 
@@ -413,19 +305,7 @@ class LayeredSemanticGraph:
         level = self._require_inspection().level
         if level.closed:
             raise InvalidInputError(f"{level.id} is closed")
-        poses = level.poses
-        index = len(poses)
-        pose = PoseNode(
-            id=naming.join(level.id, naming.pose_name(index)),
-            name=naming.pose_name(index),
-            index=index,
-            level_id=level.id,
-            position=z.position.copy(),
-            orientation=z.orientation.copy(),
-            image=z.image,
-            stamp=z.stamp,
-        )
-        self.add_pose(pose)
+        pose = self.add_pose(new_pose(level, z))
         self.revision += 1
         return pose
 
@@ -436,14 +316,7 @@ class LayeredSemanticGraph:
         """
         inspection = self._require_inspection()
         naming.check_label(z.label)
-        poses = inspection.level.poses
-        if pose_id is None:
-            if not poses:
-                raise InvalidInputError("register a pose before the features it observed")
-            pose_id = poses[-1].id
-        elif not any(p.id == pose_id for p in poses):
-            raise unknown_name("pose of the current level", pose_id, (p.id for p in poses))
-        inspection.interim.append(PoseFeaturePair(pose_id, z))
+        inspection.observe_feature(z, pose_id)
 
     def close_level(self, close_ring: bool = True) -> LevelSummary:
         """End the current level: link its last pose back to it and apply eq (10).
@@ -457,39 +330,15 @@ class LayeredSemanticGraph:
         level = inspection.level
         if level.closed:
             return LevelSummary(level.id, 0, ())
-        poses = level.poses
         if close_ring:
             self.close_ring(level)
-        kept = optimise_features(inspection.interim, self.params.d_check_F)
-        pose_order = {p.id: p.index for p in poses}
-        kept.sort(key=lambda f: pose_order[f.pose_id])  # stable: ties keep registration order
-        names: list[str] = []
-        ordinals: dict[str, int] = {}
-        for feature in kept:
-            z = feature.observation
-            ordinals[z.label] = ordinals.get(z.label, 0) + 1
-            names.append(self._add_feature(level, feature.pose_id, z, ordinals[z.label]).id)
-        summary = LevelSummary(level.id, len(inspection.interim), tuple(names))
+        features = kept_features(level, inspection.interim, self.params.d_check_F)
+        names = tuple(self.add_feature(feature).id for feature in features)
+        summary = LevelSummary(level.id, len(inspection.interim), names)
         inspection.interim = []
         level.closed = True
         self.revision += 1
         return summary
-
-    def _add_feature(
-        self, level: LevelNode, pose_id: str, z: Observation, ordinal: int
-    ) -> FeatureNode:
-        name = naming.feature_name(z.label, ordinal)
-        feature = FeatureNode(
-            id=naming.join(level.id, name),
-            name=name,
-            label=z.label,
-            pose_id=pose_id,
-            position=z.position.copy(),
-            score=z.score,
-            mask_area=z.mask_area,
-            image=z.image,
-        )
-        return self.add_feature(feature)
 
     def finish_inspection(self, polygon_level: int = 0, every_level: bool = False) -> TargetNode:
         """Close the last level, build the containment polygon and mark the target inspected.
@@ -509,17 +358,7 @@ class LayeredSemanticGraph:
         inspection = self._require_inspection()
         self.close_level()
         target = inspection.target
-        levels = target.levels
-        if not 0 <= polygon_level < len(levels):
-            raise InvalidInputError(f"{target.id} has no level {polygon_level}")
-        if every_level:
-            polygon = hull_polygon([p.position[:2] for level in levels for p in level.poses])
-        else:
-            polygon = ring_polygon([p.position[:2] for p in levels[polygon_level].poses])
-        if polygon is not None:
-            target.polygon = polygon
-            centre = polygon_centroid(polygon)
-            target.position = np.array([centre[0], centre[1], target.position[2]])
+        enclose_target(target, polygon_level, every_level)
         target.status = TargetStatus.INSPECTED
         self._inspection = None
         self.pruned = self._prune_covered(target)
@@ -527,16 +366,9 @@ class LayeredSemanticGraph:
         return target
 
     def _prune_covered(self, target: TargetNode) -> tuple[str, ...]:
-        others = self.targets(TargetStatus.DETECTED)
-        if not others:
-            return ()
-        # One vectorised test over every detected target: a mission keeps few, but a graph
-        # built offline may hold thousands, and a test per target made that quadratic.
-        positions = np.array([other.position for other in others])
-        hits = np.linalg.norm(positions - target.position, axis=1) <= self.params.d_check_T
-        if target.polygon is not None:
-            hits |= polygon_contains(target.polygon, positions[:, :2])
-        covered = tuple(other.id for other, hit in zip(others, hits, strict=True) if hit)
+        covered = covered_targets(
+            target, self.targets(TargetStatus.DETECTED), self.params.d_check_T
+        )
         for target_id in covered:
             self.discard_target(target_id)
         return covered
@@ -558,23 +390,15 @@ class LayeredSemanticGraph:
         inspection = self._require_inspection()
         target = inspection.target
         assert target.level_graph is not None
-        removed = {target.id: False}
-        for level in target.levels:
-            removed[level.id] = True
-            for pose in level.poses:
-                removed[pose.id] = True
-                removed.update((f.id, True) for f in pose.features)
-        for key in [k for k in self._edges if removed.get(k[0]) or removed.get(k[1])]:
-            del self._edges[key]
-        for node_id, gone in removed.items():
-            if gone:
-                del self._nodes[node_id]
+        poses = [pose for level in target.levels for pose in level.poses]
+        gone: list[Node] = [*target.levels, *poses, *(f for p in poses for f in p.features)]
+        self.unified.remove(node.id for node in gone)
         target.level_graph = None
         self._inspection = None
         self.revision += 1
         return target
 
-    def _require_inspection(self) -> _Inspection:
+    def _require_inspection(self) -> Inspection:
         if self._inspection is None:
             raise InvalidInputError("no inspection in progress; call begin_inspection first")
         return self._inspection
@@ -584,8 +408,8 @@ class LayeredSemanticGraph:
     # put a node into its local graph and the unified graph, with the edges its layer implies.
     def add_target(self, target: TargetNode) -> TargetNode:
         """Insert a target node into the Target layer, joined to the robot."""
-        self._add_to(self.target_graph, target)
-        self._connect(self.target_graph, self.robot, target, EdgeKind.SYMBOLIC)
+        self.unified.add(self.target_graph, target)
+        self.unified.connect(self.target_graph, self.robot, target, EdgeKind.SYMBOLIC)
         return target
 
     def add_level(self, level: LevelNode, via: ArrayLike | None = None) -> LevelNode:
@@ -595,10 +419,10 @@ class LayeredSemanticGraph:
         if target.level_graph is None:
             target.level_graph = LocalGraph(Layer.LEVEL, target)
         previous = target.levels[-1] if target.levels else None
-        self._add_to(target.level_graph, level)
-        self._connect(target.level_graph, target, level, EdgeKind.SYMBOLIC)
+        self.unified.add(target.level_graph, level)
+        self.unified.connect(target.level_graph, target, level, EdgeKind.SYMBOLIC)
         if previous is not None:
-            self._link(target.level_graph, previous, level, via)
+            self.unified.link(target.level_graph, previous, level, via)
         elif via is not None:
             raise InvalidInputError(f"{level.id} is the first level; it has no edge to realise")
         return level
@@ -608,8 +432,10 @@ class LayeredSemanticGraph:
         that pose, or to the level for its first pose."""
         level = self._node_of(pose.level_id, LevelNode)
         poses = level.poses
-        self._add_to(level.pose_graph, pose)
-        self._connect(level.pose_graph, poses[-1] if poses else level, pose, EdgeKind.SPATIAL)
+        self.unified.add(level.pose_graph, pose)
+        self.unified.connect(
+            level.pose_graph, poses[-1] if poses else level, pose, EdgeKind.SPATIAL
+        )
         return pose
 
     def close_ring(self, level: LevelNode) -> None:
@@ -617,7 +443,7 @@ class LayeredSemanticGraph:
         more poses."""
         poses = level.poses
         if len(poses) > 1:
-            self._connect(level.pose_graph, poses[-1], level, EdgeKind.SPATIAL)
+            self.unified.connect(level.pose_graph, poses[-1], level, EdgeKind.SPATIAL)
 
     def add_feature(self, feature: FeatureNode) -> FeatureNode:
         """Insert a feature into the Feature graph of the pose that observed it
@@ -625,8 +451,8 @@ class LayeredSemanticGraph:
         pose = self._node_of(feature.pose_id, PoseNode)
         if pose.feature_graph is None:
             pose.feature_graph = LocalGraph(Layer.FEATURE, pose)
-        self._add_to(pose.feature_graph, feature)
-        self._connect(pose.feature_graph, pose, feature, EdgeKind.SYMBOLIC)
+        self.unified.add(pose.feature_graph, feature)
+        self.unified.connect(pose.feature_graph, pose, feature, EdgeKind.SYMBOLIC)
         return feature
 
     def _node_of(self, node_id: str, kind: type[N]) -> N:
@@ -634,60 +460,6 @@ class LayeredSemanticGraph:
         if not isinstance(node, kind):
             raise InvalidInputError(f"{node_id!r} is not a {kind.__name__}")
         return node
-
-    # ------------------------------------------------------------------ union
-    def _add_to(self, local: LocalGraph, node: Node) -> None:
-        """Register ``node`` in ``local`` and merge it into the unified graph (V and A union)."""
-        if node.id in self._nodes and self._nodes[node.id] is not node:
-            raise InvalidInputError(f"node id {node.id!r} already exists")
-        local.nodes[node.id] = node
-        self._nodes[node.id] = node
-
-    def _link(
-        self,
-        local: LocalGraph,
-        a: Node,
-        b: Node,
-        via: ArrayLike | None,
-        ends: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
-    ) -> Edge:
-        """A spatial edge realised by the polyline ``ends[0]``, ``via``, ``ends[1]`` (the two
-        nodes' positions by default), weighing its length: the Euclidean distance when there is
-        no ``via``. ``via`` is stored oriented along the edge's canonical key."""
-        start, end = ends if ends is not None else (a.position, b.position)
-        inner = (
-            np.empty((0, 3)) if via is None else np.asarray(via, dtype=np.float64).reshape(-1, 3)
-        )
-        if not np.all(np.isfinite(inner)):
-            raise InvalidInputError("via points must be finite")
-        if a.id > b.id:  # orient along the canonical key, so the sum is reproducible
-            a, b, start, end, inner = b, a, end, start, inner[::-1]
-        polyline = np.vstack([start, inner, end])
-        weight = float(np.linalg.norm(np.diff(polyline, axis=0), axis=1).sum())
-        return self._connect(
-            local, a, b, EdgeKind.SPATIAL, weight=weight, via=inner if len(inner) else None
-        )
-
-    def _connect(
-        self,
-        local: LocalGraph,
-        a: Node,
-        b: Node,
-        kind: EdgeKind,
-        *,
-        weight: float | None = None,
-        via: NDArray[np.float64] | None = None,
-    ) -> Edge:
-        """Register an edge in ``local`` and merge it into the unified graph (E union)."""
-        if weight is None:
-            weight = (
-                float(np.linalg.norm(a.position - b.position)) if kind is EdgeKind.SPATIAL else 0.0
-            )
-        u, v = (a.id, b.id) if a.id <= b.id else (b.id, a.id)
-        edge = Edge(u, v, kind, weight, via)
-        local.edges[edge.key] = edge
-        self._edges[edge.key] = edge
-        return edge
 
     # ------------------------------------------------------------------ statistics
     def local_graphs(self, layer: Layer) -> list[LocalGraph]:
@@ -711,18 +483,13 @@ class LayeredSemanticGraph:
 
     def population(self) -> PopulationStats:
         """The graph columns of 000 Table 3 for the graph as it is now."""
-
-        def summed(layer: Layer) -> LayerPopulation:
-            counts = [g.population() for g in self.local_graphs(layer)]
-            return LayerPopulation(sum(c[0] for c in counts), sum(c[1] for c in counts))
-
         targets = self.targets()
         return PopulationStats(
-            target=summed(Layer.TARGET),
-            level=summed(Layer.LEVEL),
-            pose=summed(Layer.POSE),
-            feature=summed(Layer.FEATURE),
-            unified=LayerPopulation(len(self._nodes), len(self._edges)),
+            target=LayerPopulation.summed(self.local_graphs(Layer.TARGET)),
+            level=LayerPopulation.summed(self.local_graphs(Layer.LEVEL)),
+            pose=LayerPopulation.summed(self.local_graphs(Layer.POSE)),
+            feature=LayerPopulation.summed(self.local_graphs(Layer.FEATURE)),
+            unified=LayerPopulation(len(self.unified.nodes), len(self.unified.edges)),
             targets_detected=len(targets),
             targets_inspected=sum(1 for t in targets if t.inspected),
         )

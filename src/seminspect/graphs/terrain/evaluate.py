@@ -9,6 +9,9 @@
   prompt's threshold. Text similarity alone would score 'trunk' against whatever caption its
   embedding happens to sit nearest; the chosen class, how it was chosen and its similarity are
   reported beside the scores.
+
+:class:`ObjectQuality`, :class:`PlaceQuality` and :class:`TerrainQuality` hold these scores per
+prompt; their ``to_json`` gives the records of a run's ``summary.json``.
 """
 
 from __future__ import annotations
@@ -50,7 +53,7 @@ class ObjectScores:
     def recall(self) -> float:
         return self.matched / self.ground_truth if self.ground_truth else 0.0
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_json(self) -> dict[str, Any]:
         return {
             "iou_threshold": self.threshold,
             "predicted": self.predicted,
@@ -119,7 +122,7 @@ class ClassMatch:
     by: Literal["name", "alias", "similarity", "none"]
     similarity: float | None
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_json(self) -> dict[str, Any]:
         return {
             "ground_truth_class": self.truth,
             "class_chosen_by": self.by,
@@ -184,7 +187,7 @@ class PlaceScores:
         """Every scored patch got a connected place graph."""
         return self.connected == self.patches
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_json(self) -> dict[str, Any]:
         record = {**asdict(self), "all_connected": self.all_connected}
         return {**record, "worst_offset": finite_or_none(self.worst_offset)}
 
@@ -234,3 +237,63 @@ def score_places(
         off_terrain=int(np.sum(offsets > tolerance)),
         worst_offset=float(offsets.max(initial=0.0)),
     )
+
+
+@dataclass(frozen=True)
+class ObjectQuality:
+    """An object prompt's ground-truth class and its detections' scores against that class.
+
+    Attributes:
+        match: the class the prompt is scored against.
+        scores: precision and recall, or ``None`` when the truth cannot score the class.
+        unscored: why a chosen class was not scored (the truth has no instances of it).
+    """
+
+    match: ClassMatch
+    scores: ObjectScores | None = None
+    unscored: str | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        record = self.match.to_json()
+        if self.unscored is not None:
+            record["unscored"] = self.unscored
+        if self.scores is not None:
+            record.update(self.scores.to_json())
+        return record
+
+
+@dataclass(frozen=True)
+class PlaceQuality:
+    """A terrain prompt's ground-truth class and how its points and places lie on that class.
+
+    Attributes:
+        match: the class the prompt is scored against.
+        points_on_terrain: share of the prompt's layer-1 points on a true patch of the class;
+            ``None`` without layer-1 points of the prompt.
+        scores: the prompt's places against the class's patches.
+    """
+
+    match: ClassMatch
+    points_on_terrain: float | None
+    scores: PlaceScores
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            **self.match.to_json(),
+            "points_on_terrain": self.points_on_terrain,
+            **self.scores.to_json(),
+        }
+
+
+@dataclass(frozen=True)
+class TerrainQuality:
+    """A terrain scene graph scored against a world's truth, per object and terrain prompt."""
+
+    objects: dict[str, ObjectQuality]
+    places: dict[str, PlaceQuality]
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "objects": {prompt: q.to_json() for prompt, q in self.objects.items()},
+            "places": {prompt: q.to_json() for prompt, q in self.places.items()},
+        }

@@ -1,9 +1,10 @@
 """Learned inspection: the semantic deep-RL planner of paper 004.
 
-The rooms and vector environment, baselines and evaluation need only numpy and gymnasium. The
-policy network (``learning.policy``: 004 Sec III-D, Fig 2) and its recurrent PPO trainer
-(``learning.ppo``) need torch (the ``rl`` extra); those names are imported on first use, so
-importing the package, or its environment, does not load torch.
+The rooms and vector environment, baselines, evaluation and the training settings need only
+numpy, numba, pydantic and gymnasium. The policy network (``learning.policy``: 004 Sec III-D,
+Fig 2) and its recurrent PPO trainer (``learning.ppo``, with ``learning.rollout`` and
+``learning.checkpoints``) need torch (the ``rl`` extra); those names are imported on first use,
+so importing the package, or its environment, does not load torch.
 """
 
 from __future__ import annotations
@@ -12,17 +13,18 @@ import importlib
 from typing import Any
 
 from seminspect.missions.learning.baselines import Controller, OrbitController, RandomController
-from seminspect.missions.learning.env import EnvConfig, InspectionEnv, InspectionVectorEnv
+from seminspect.missions.learning.env import InspectionEnv, InspectionVectorEnv
+from seminspect.missions.learning.env_config import EnvConfig
 from seminspect.missions.learning.evaluation import EpisodeTrace, EvaluationResult, evaluate
 from seminspect.missions.learning.rooms import Room, sample_room
+from seminspect.missions.learning.train_config import TrainConfig
 
 #: Public name -> the module that defines it (imported lazily: torch is an optional extra).
 _LAZY = {
     "InspectionPolicy": "seminspect.missions.learning.policy",
     "PolicyConfig": "seminspect.missions.learning.policy",
-    "load_policy": "seminspect.missions.learning.ppo",
+    "load_policy": "seminspect.missions.learning.checkpoints",
     "train": "seminspect.missions.learning.ppo",
-    "TrainConfig": "seminspect.missions.learning.ppo",
     "LearnedController": "seminspect.missions.learning.agent",
     "load_controller": "seminspect.missions.learning.agent",
 }

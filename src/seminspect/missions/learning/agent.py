@@ -15,9 +15,9 @@ import numpy as np
 import torch
 from numpy.typing import NDArray
 
+from seminspect.missions.learning.checkpoints import load_policy
 from seminspect.missions.learning.env import InspectionVectorEnv
 from seminspect.missions.learning.policy import InspectionPolicy, as_tensors
-from seminspect.missions.learning.ppo import load_policy
 
 #: The checkpoint inside the package: (package, relative path).
 SHIPPED_POLICY = ("seminspect", "data/rl/policy.pt")

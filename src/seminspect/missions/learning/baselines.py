@@ -17,7 +17,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from seminspect.core.rng import make_rng
-from seminspect.missions.learning.env import ACTION_SIZE, InspectionVectorEnv, body_from_world
+from seminspect.geometry.transforms import body_from_world
+from seminspect.missions.learning.env import InspectionVectorEnv
+from seminspect.missions.learning.env_config import ACTION_SIZE
 
 
 class Controller(Protocol):

@@ -23,8 +23,13 @@ Per step (10 Hz, the paper's image rate):
 
 The state vector (17 values): position relative to the room centre divided by the half size,
 quaternion (w, x, y, z), body-frame linear velocity (m/s), angular velocity (rad/s), then the
-previous action. The paper states velocities in the inertial frame; body-frame velocities keep
-the whole observation ego-centric like the maps, which the policy then need not rotate.
+previous action. The quaternion is scalar-first, unlike seminspect's ``[x, y, z, w]`` poses
+(:mod:`seminspect.geometry.transforms`): the shipped policy was trained on this order. The
+paper states velocities in the inertial frame; body-frame velocities keep the whole
+observation ego-centric like the maps, which the policy then need not rotate.
+
+The parts have modules of their own: :mod:`.env_config` (the settings), :mod:`.sensors`,
+:mod:`.maps`, :mod:`.rewards` and :mod:`.dynamics`; this one steps them together.
 """
 
 from __future__ import annotations
@@ -34,348 +39,46 @@ from collections.abc import Sequence
 from typing import Any
 
 import gymnasium as gym
-import numba
 import numpy as np
 from gymnasium.vector import AutoresetMode
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.rng import make_rng
+from seminspect.geometry.transforms import body_from_world, world_from_body
+from seminspect.missions.learning.dynamics import first_order_step
+from seminspect.missions.learning.env_config import ACTION_SIZE, STATE_SIZE, EnvConfig
+from seminspect.missions.learning.maps import (
+    ego_offsets,
+    gather_ego,
+    mark_hits,
+    spatial_visit_scores,
+)
+from seminspect.missions.learning.rewards import (
+    collision_penalty,
+    face_scores,
+    semantic_search_reward,
+)
 from seminspect.missions.learning.rooms import (
     TARGET_FACES,
     Room,
     clearance,
     sample_room,
+    side_by_side,
     stack_solids,
+)
+from seminspect.missions.learning.sensors import (
+    camera_rays,
+    focus_mask,
+    lidar_rays,
+    mapping_pixels,
+    noisy_ranges,
+    sensor_rays,
 )
 from seminspect.worlds.raycast import RayCaster
 
-STATE_SIZE = 17
-ACTION_SIZE = 4
 #: Gap between neighbouring rooms in the shared ray-casting scene (metres).
 ROOM_GAP = 2.0
-
-
-class EnvConfig(BaseModel):
-    """Parameters of the environment; defaults follow 004 where it gives a value."""
-
-    model_config = ConfigDict(frozen=True, extra="forbid")
-
-    obstacles: int = Field(9, ge=0, le=60, description="obstacles per room (Table I: 0-19)")
-    room_size: tuple[float, float, float] = (10.0, 10.0, 4.0)
-    episode_seconds: float = Field(90.0, gt=0.0, description="004 Sec III-E: 90 s")
-    control_hz: float = Field(10.0, gt=0.0, description="image rate, 004 Sec III-E")
-    image_size: tuple[int, int] = (96, 54)
-    fov_deg: tuple[float, float] = (87.0, 58.0)
-    camera_range: float = Field(10.0, gt=0.0)
-    lidar_beams: tuple[int, int] = (32, 8)
-    map_cells: int = Field(21, ge=3, description="n of the n^3 ego maps (004: 21)")
-    map_resolution: float = Field(0.1, gt=0.0, description="r_V (004: 0.1 m)")
-    max_speed: float = Field(1.0, gt=0.0, description="w_max linear (004: 1 m/s)")
-    max_yaw_rate: float = Field(1.0, gt=0.0, description="w_max yaw (004: 1 rad/s)")
-    velocity_time_constant: float = Field(0.2, gt=0.0)
-    disturbance_std: float = Field(0.3, ge=0.0, description="m/s^2, redrawn every step")
-    state_noise: float = Field(0.02, ge=0.0, description="uniform half-width, SI units")
-    depth_noise: tuple[float, float] = (0.005, 0.01)  # sigma = a + b * range
-    d_ref: float = Field(1.5, gt=0.0, description="reference inspection distance (004: 0.5-2.5)")
-    inspect_range: float = Field(3.0, gt=0.0, description="a face counts as covered within it")
-    alpha: float = Field(0.15, gt=0.0, description="eq (7) gain")
-    beta: float = Field(1.0, gt=0.0, description="eq (7) distance fall-off")
-    gamma: float = Field(0.005, ge=0.0, description="eq (10) gain")
-    delta: float = Field(0.02, ge=0.0, description="eq (10) fall-off per visit")
-    d_coll: float = Field(0.3, gt=0.0, description="collision distance (004: 0.3 m)")
-    robot_radius: float = Field(0.2, gt=0.0)
-    crash_penalty: float = Field(5.0, ge=0.0, description="extra penalty when a crash ends")
-    use_svs: bool = Field(True, description="False: m^h is all zeros (Table II)")
-
-    @model_validator(mode="after")
-    def _consistent(self) -> EnvConfig:
-        if self.map_cells % 2 == 0:
-            raise ValueError("map_cells must be odd so the robot sits in the centre cell")
-        if min(self.room_size) <= 0 or min(self.image_size) <= 0 or min(self.lidar_beams) <= 0:
-            raise ValueError("room, image and LiDAR sizes must be positive")
-        if self.robot_radius > self.d_coll:
-            raise ValueError("robot_radius must not exceed d_coll")
-        return self
-
-    @property
-    def steps_per_episode(self) -> int:
-        return round(self.episode_seconds * self.control_hz)
-
-
-def _camera_rays(config: EnvConfig) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
-    """Body-frame unit rays of the pinhole camera (x forward, y left, z up) and their cosines."""
-    width, height = config.image_size
-    h_fov, v_fov = np.radians(config.fov_deg)
-    u = (np.arange(width) + 0.5) / width * 2.0 - 1.0
-    v = (np.arange(height) + 0.5) / height * 2.0 - 1.0
-    uu, vv = np.meshgrid(u, v)
-    rays = np.stack(
-        [np.ones_like(uu), -uu * math.tan(h_fov / 2), -vv * math.tan(v_fov / 2)], axis=-1
-    ).reshape(-1, 3)
-    rays /= np.linalg.norm(rays, axis=1, keepdims=True)
-    return rays.astype(np.float32), rays[:, 0].astype(np.float32)
-
-
-def _lidar_rays(config: EnvConfig) -> NDArray[np.float32]:
-    """Body-frame unit rays of a 360 x 90 deg LiDAR."""
-    n_az, n_el = config.lidar_beams
-    az = np.linspace(-math.pi, math.pi, n_az, endpoint=False)
-    el = np.radians(np.linspace(-45.0, 45.0, n_el))
-    aa, ee = np.meshgrid(az, el)
-    rays = np.stack([np.cos(ee) * np.cos(aa), np.cos(ee) * np.sin(aa), np.sin(ee)], axis=-1)
-    return rays.reshape(-1, 3).astype(np.float32)
-
-
-def _focus_mask(config: EnvConfig) -> NDArray[np.bool_]:
-    """Central half of the image in each dimension: the focus area of 004 Sec III-C."""
-    width, height = config.image_size
-    cols = np.abs(np.arange(width) + 0.5 - width / 2) < width / 4
-    rows = np.abs(np.arange(height) + 0.5 - height / 2) < height / 4
-    return (rows[:, None] & cols[None, :]).reshape(-1)
-
-
-def _mapping_pixels(config: EnvConfig) -> NDArray[np.bool_]:
-    """Every third pixel in each direction: the camera returns that feed the map.
-
-    At the ego map's reach (about 1 m) their spacing is about 6 cm, finer than its 0.1 m cells.
-    """
-    width, height = config.image_size
-    rows, cols = np.arange(height) % 3 == 1, np.arange(width) % 3 == 1
-    return (rows[:, None] & cols[None, :]).reshape(-1)
-
-
-def _ego_offsets(config: EnvConfig) -> NDArray[np.float64]:
-    """Body-frame centres of the n^3 ego-map cells, x fastest-varying last (D, H, W = z, y, x)."""
-    half = config.map_cells // 2
-    steps = (np.arange(config.map_cells) - half) * config.map_resolution
-    zz, yy, xx = np.meshgrid(steps, steps, steps, indexing="ij")
-    return np.stack([xx, yy, zz], axis=-1).reshape(-1, 3)
-
-
-@numba.njit(cache=True)
-def _hits_upright_cylinder(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
-    ox: float,
-    oy: float,
-    oz: float,
-    dx: float,
-    dy: float,
-    dz: float,
-    cx: float,
-    cy: float,
-    cz: float,
-    radius: float,
-    half: float,
-    reach: float,
-) -> bool:
-    """Whether a ray meets an upright cylinder within ``reach`` (a conservative bound test)."""
-    t_low, t_high = 0.0, reach
-    if abs(dz) < 1e-12:
-        if abs(oz - cz) > half:
-            return False
-    else:
-        t1, t2 = (cz - half - oz) / dz, (cz + half - oz) / dz
-        t_low, t_high = max(t_low, min(t1, t2)), min(t_high, max(t1, t2))
-    px, py = ox - cx, oy - cy
-    a = dx * dx + dy * dy
-    b = px * dx + py * dy
-    c = px * px + py * py - radius * radius
-    if a < 1e-12:
-        return c <= 0.0 and t_low <= t_high
-    disc = b * b - a * c
-    if disc < 0.0:
-        return False
-    root = math.sqrt(disc)
-    return max(t_low, (-b - root) / a) <= min(t_high, (-b + root) / a)
-
-
-@numba.njit(cache=True)
-def _sensor_rays(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
-    origin: NDArray[np.float64],
-    yaw: NDArray[np.float64],
-    camera: NDArray[np.float32],
-    lidar: NDArray[np.float32],
-    mapped: NDArray[np.bool_],
-    target_centre: NDArray[np.float64],
-    target_size: NDArray[np.float64],
-    reach: float,
-) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float32], NDArray[np.float32]]:
-    """The rays each room needs, grouped by room: (row, ray id, origin, direction).
-
-    Camera pixels are cast when they may see the target (their ray meets its bounding
-    cylinder) or when they belong to the mapping subset ``mapped``; every LiDAR beam is cast.
-    A pixel left out can only see something other than the target, so the masked depth and
-    the face reward are exact; only the map takes fewer (coarser) camera returns.
-    """
-    n_cam, n_lidar = camera.shape[0], lidar.shape[0]
-    per_room = n_cam + n_lidar
-    rows = np.empty(origin.shape[0] * per_room, dtype=np.int64)
-    ids = np.empty_like(rows)
-    count = 0
-    for r in range(origin.shape[0]):
-        c, s = math.cos(yaw[r]), math.sin(yaw[r])
-        tc, tr, th = target_centre[r], target_size[r, 0] + 1e-3, target_size[r, 1] + 1e-3
-        for k in range(n_cam):
-            keep = mapped[k]
-            if not keep:
-                dx = c * camera[k, 0] - s * camera[k, 1]
-                dy = s * camera[k, 0] + c * camera[k, 1]
-                keep = _hits_upright_cylinder(
-                    origin[r, 0],
-                    origin[r, 1],
-                    origin[r, 2],
-                    dx,
-                    dy,
-                    camera[k, 2],
-                    tc[0],
-                    tc[1],
-                    tc[2],
-                    tr,
-                    th,
-                    reach,
-                )
-            if keep:
-                rows[count], ids[count] = r, k
-                count += 1
-        for k in range(n_lidar):
-            rows[count], ids[count] = r, n_cam + k
-            count += 1
-    starts = np.empty((count, 3), dtype=np.float32)
-    dirs = np.empty((count, 3), dtype=np.float32)
-    for i in range(count):
-        r, k = rows[i], ids[i]
-        body = camera[k] if k < n_cam else lidar[k - n_cam]
-        c, s = math.cos(yaw[r]), math.sin(yaw[r])
-        dirs[i, 0] = c * body[0] - s * body[1]
-        dirs[i, 1] = s * body[0] + c * body[1]
-        dirs[i, 2] = body[2]
-        starts[i, 0], starts[i, 1], starts[i, 2] = origin[r, 0], origin[r, 1], origin[r, 2]
-    return rows[:count], ids[:count], starts, dirs
-
-
-@numba.njit(cache=True)
-def _mark_hits(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
-    occupancy: NDArray[np.uint8],
-    env_of_ray: NDArray[np.int64],
-    starts: NDArray[np.float32],
-    dirs: NDArray[np.float32],
-    distance: NDArray[np.float64],
-    room_shift: NDArray[np.float64],
-    row: NDArray[np.int64],
-    resolution: float,
-) -> None:
-    """Mark the cell of every ranged return as occupied in its robot's own map (Sec III-A)."""
-    nz, ny, nx = occupancy.shape[1], occupancy.shape[2], occupancy.shape[3]
-    for i in range(distance.shape[0]):
-        d = distance[i]
-        if not math.isfinite(d):
-            continue
-        shift = room_shift[row[i]]
-        x = starts[i, 0] - shift[0] + dirs[i, 0] * d
-        y = starts[i, 1] - shift[1] + dirs[i, 1] * d
-        z = starts[i, 2] - shift[2] + dirs[i, 2] * d
-        a = min(max(math.floor(x / resolution), 0), nx - 1)
-        b = min(max(math.floor(y / resolution), 0), ny - 1)
-        m = min(max(math.floor(z / resolution), 0), nz - 1)
-        occupancy[env_of_ray[i], m, b, a] = 1
-
-
-@numba.njit(cache=True)
-def _gather_ego(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
-    occupancy: NDArray[np.uint8],
-    visits: NDArray[np.uint16],
-    rows: NDArray[np.int64],
-    position: NDArray[np.float64],
-    yaw: NDArray[np.float64],
-    offsets: NDArray[np.float64],
-    resolution: float,
-    out_occupancy: NDArray[np.float32],
-    out_visits: NDArray[np.float32],
-) -> None:
-    """Sample the robots' world-frame maps at the yaw-rotated ego cells (outside: occupied)."""
-    nz, ny, nx = occupancy.shape[1], occupancy.shape[2], occupancy.shape[3]
-    for r in range(rows.shape[0]):
-        env = rows[r]
-        c, s = math.cos(yaw[r]), math.sin(yaw[r])
-        px, py, pz = position[r, 0], position[r, 1], position[r, 2]
-        for k in range(offsets.shape[0]):
-            ox, oy, oz = offsets[k, 0], offsets[k, 1], offsets[k, 2]
-            i = math.floor((px + c * ox - s * oy) / resolution)
-            j = math.floor((py + s * ox + c * oy) / resolution)
-            m = math.floor((pz + oz) / resolution)
-            if 0 <= i < nx and 0 <= j < ny and 0 <= m < nz:
-                out_occupancy[r, k] = occupancy[env, m, j, i]
-                out_visits[r, k] = visits[env, m, j, i]
-            else:
-                out_occupancy[r, k] = 1.0
-                out_visits[r, k] = 0.0
-
-
-@numba.njit(cache=True)
-def _entropy_in_place(counts: NDArray[np.float32], totals: NDArray[np.float64]) -> None:
-    """Rows of visit counts -> -p log p with p = count / row total (eq (3)); totals out."""
-    for r in range(counts.shape[0]):
-        total = 0.0
-        for k in range(counts.shape[1]):
-            total += counts[r, k]
-        totals[r] = total
-        if total <= 0.0:
-            continue
-        for k in range(counts.shape[1]):
-            if counts[r, k] > 0.0:
-                p = counts[r, k] / total
-                counts[r, k] = -p * math.log(p)
-
-
-def spatial_visit_scores(counts: NDArray) -> tuple[NDArray[np.float32], NDArray[np.float64]]:
-    """004 eq (3): m^h = -p log p, p the visits of a cell over the local total N_t.
-
-    ``counts`` is ``(rows, cells)``; returns the scores and N_t of each row.
-    """
-    scores = np.array(counts, dtype=np.float32, copy=True)
-    totals = np.empty(len(scores))
-    _entropy_in_place(scores, totals)
-    return scores, totals
-
-
-def world_from_body(vectors: NDArray, yaw: NDArray) -> NDArray[np.float64]:
-    """Rows of body-frame vectors in the world frame of a level vehicle with heading ``yaw``."""
-    c, s = np.cos(yaw), np.sin(yaw)
-    x, y = vectors[:, 0], vectors[:, 1]
-    return np.stack([c * x - s * y, s * x + c * y, vectors[:, 2]], 1)
-
-
-def body_from_world(vectors: NDArray, yaw: NDArray) -> NDArray[np.float64]:
-    """Rows of world-frame vectors in the body frame of a level vehicle with heading ``yaw``."""
-    c, s = np.cos(yaw), np.sin(yaw)
-    x, y = vectors[:, 0], vectors[:, 1]
-    return np.stack([c * x + s * y, -s * x + c * y, vectors[:, 2]], 1)
-
-
-def face_scores(
-    distance: NDArray[np.float64],
-    best: NDArray[np.float64],
-    d_ref: float,
-    alpha: float,
-    beta: float,
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """004 eqs (7)-(8): per-face inspection scores n_f and the updated best distances d_f.
-
-    ``distance`` holds this step's mean camera-face distance (nan for faces not in view);
-    ``best`` the stored d_f (inf before the first view).
-    """
-    seen = np.isfinite(distance)
-    closer = seen & (np.abs(np.where(seen, distance, 0.0) - d_ref) < np.abs(best - d_ref))
-    scores = np.where(
-        closer, alpha * np.exp(-beta * (np.where(seen, distance, 0.0) - d_ref) ** 2), 0.0
-    )
-    return scores, np.where(scores > 0, distance, best)
-
-
-def semantic_search_reward(visits: NDArray, gamma: float, delta: float) -> NDArray[np.float64]:
-    """004 eq (10): v_t = gamma exp(-delta N_t)."""
-    return gamma * np.exp(-delta * np.asarray(visits, dtype=np.float64))
 
 
 class InspectionVectorEnv(gym.vector.VectorEnv):
@@ -428,11 +131,12 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         self.action_space = gym.vector.utils.batch_space(self.single_action_space, self.num_envs)
 
     def _build_sensors(self) -> None:
-        self._camera, self._camera_cos = _camera_rays(self.config)
-        self._lidar = _lidar_rays(self.config)
-        self._focus = _focus_mask(self.config)
-        self._mapped = _mapping_pixels(self.config)
-        self._offsets = _ego_offsets(self.config)
+        cfg = self.config
+        self._camera, self._camera_cos = camera_rays(cfg.image_size, cfg.fov_deg)
+        self._lidar = lidar_rays(cfg.lidar_beams)
+        self._focus = focus_mask(cfg.image_size)
+        self._mapped = mapping_pixels(cfg.image_size)
+        self._offsets = ego_offsets(cfg.map_cells, cfg.map_resolution)
         self._near = np.linalg.norm(self._offsets, axis=1) <= self.config.d_coll
         self._spacing = self.config.room_size[0] + ROOM_GAP
 
@@ -585,15 +289,8 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         return self._copy_obs()
 
     def _rebuild_scene(self) -> None:
-        """One Embree scene holding every room, room ``i`` shifted by ``i * spacing`` along x."""
-        vertices, triangles, faces, base = [], [], [], 0
-        for i, room in enumerate(self._rooms):
-            vertices.append(room.vertices + np.array([i * self._spacing, 0.0, 0.0]))
-            triangles.append(room.triangles + base)
-            faces.append(room.face_of_triangle)
-            base += len(room.vertices)
-        self._caster = RayCaster(np.vstack(vertices), np.vstack(triangles))
-        self._face_of_triangle = np.concatenate(faces)
+        vertices, triangles, self._face_of_triangle = side_by_side(self._rooms, self._spacing)
+        self._caster = RayCaster(vertices, triangles)
 
     def _copy_obs(self) -> dict[str, NDArray[np.float32]]:
         return {key: value.copy() for key, value in self._obs.items()}
@@ -604,28 +301,23 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         """Exact first-order velocity response over one step, with a disturbance (eq (5))."""
         cfg = self.config
         dt, tau = 1.0 / cfg.control_hz, cfg.velocity_time_constant
-        decay = math.exp(-dt / tau)
         a = action[envs].astype(np.float64)
         command = world_from_body(a[:, :3] * cfg.max_speed, self._yaw[envs])
         push = np.stack([self._rngs[e].normal(0.0, cfg.disturbance_std, 3) for e in envs])
         command += push * tau
-        v = self._velocity[envs]
-        self._position[envs] += command * dt + (v - command) * tau * (1.0 - decay)
-        self._velocity[envs] = command + (v - command) * decay
+        moved, self._velocity[envs] = first_order_step(self._velocity[envs], command, dt, tau)
+        self._position[envs] += moved
         yaw_command = a[:, 3] * cfg.max_yaw_rate
-        w = self._yaw_rate[envs]
-        self._yaw[envs] += yaw_command * dt + (w - yaw_command) * tau * (1.0 - decay)
+        turned, self._yaw_rate[envs] = first_order_step(self._yaw_rate[envs], yaw_command, dt, tau)
+        self._yaw[envs] += turned
+        # [-pi, pi) by floor modulo; wrap_angle's remainder rounds otherwise
         self._yaw[envs] = (self._yaw[envs] + math.pi) % (2.0 * math.pi) - math.pi
-        self._yaw_rate[envs] = yaw_command + (w - yaw_command) * decay
         self._previous_action[envs] = action[envs]
 
     def _crashed(self, envs: NDArray[np.int64]) -> NDArray[np.bool_]:
         solids = self._solids
         assert solids is not None
-        subset = type(solids)(
-            solids.kind[envs], solids.centre[envs], solids.rotation[envs], solids.size[envs]
-        )
-        gap = clearance(self._position[envs], subset, np.asarray(self.config.room_size))
+        gap = clearance(self._position[envs], solids.rows(envs), np.asarray(self.config.room_size))
         return gap < self.config.robot_radius
 
     # -- sensing ---------------------------------------------------------------------------------
@@ -637,7 +329,7 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         target = self._solids.centre[envs, 0], self._solids.size[envs, 0]
         shift = np.outer(envs * self._spacing, (1.0, 0.0, 0.0))  # rooms' places in the scene
         origin = self._position[envs] + shift
-        row, ray, starts, dirs = _sensor_rays(
+        row, ray, starts, dirs = sensor_rays(
             origin,
             self._yaw[envs],
             self._camera,
@@ -650,16 +342,7 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         distance, tri = self._caster.cast(starts, dirs, cfg.camera_range, self.threads)
         distance = distance.astype(np.float64)
         noisy = self._noisy(envs, row, distance)
-        _mark_hits(
-            self._occupancy,
-            envs[row],
-            starts,
-            dirs,
-            noisy,
-            shift,
-            row,
-            cfg.map_resolution,
-        )
+        mark_hits(self._occupancy, envs[row], starts, dirs, noisy, shift, row, cfg.map_resolution)
         face = np.where(tri >= 0, self._face_of_triangle[np.maximum(tri, 0)], -1)
         on_target = np.flatnonzero((face >= 0) & (ray < len(self._camera)))
         self._fill_depth(envs, row[on_target], ray[on_target], noisy[on_target])
@@ -676,19 +359,13 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         return f_t + v_t + p_t
 
     def _noisy(self, envs: NDArray[np.int64], row: NDArray, distance: NDArray) -> NDArray:
-        """Ranges with Gaussian noise whose sigma grows linearly with range (Sec III-E).
-
-        Each room draws its own noise from its own stream (rays come grouped by room).
-        """
-        a, b = self.config.depth_noise
+        """:func:`noisy_ranges`, each room drawing its noise from its own stream (the rays come
+        grouped by room)."""
         counts = np.bincount(row, minlength=len(envs))
         noise = np.concatenate(
             [self._rngs[e].standard_normal(n) for e, n in zip(envs, counts, strict=True)]
         )
-        finite = np.isfinite(distance)
-        clean = np.where(finite, distance, 0.0)
-        noisy = np.clip(clean + noise * (a + b * clean), 0.0, self.config.camera_range)
-        return np.where(finite, noisy, np.inf)
+        return noisy_ranges(distance, noise, self.config.depth_noise, self.config.camera_range)
 
     def _fill_depth(self, envs: NDArray, row: NDArray, pixel: NDArray, noisy: NDArray) -> None:
         """D_t∘S_t: noisy z-depth on target pixels, scaled by the camera range (eq (4))."""
@@ -725,7 +402,7 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         n = cfg.map_cells
         occupancy = np.empty((len(envs), n**3), dtype=np.float32)
         counts = np.empty((len(envs), n**3), dtype=np.float32)
-        _gather_ego(
+        gather_ego(
             self._occupancy,
             self._visits,
             envs,
@@ -736,12 +413,11 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
             occupancy,
             counts,
         )
-        totals = np.empty(len(envs))
-        _entropy_in_place(counts, totals)
+        scores, totals = spatial_visit_scores(counts)
         maps = self._obs["maps"]
         maps[envs, 0] = occupancy.reshape(len(envs), n, n, n)
-        maps[envs, 1] = counts.reshape(len(envs), n, n, n) if cfg.use_svs else 0.0
-        penalty = np.where(occupancy[:, self._near].any(axis=1), -1.0, 0.0)
+        maps[envs, 1] = scores.reshape(len(envs), n, n, n) if cfg.use_svs else 0.0
+        penalty = collision_penalty(occupancy[:, self._near])
         return semantic_search_reward(totals, cfg.gamma, cfg.delta), penalty
 
     def _fill_state(self, envs: NDArray[np.int64]) -> None:
@@ -753,6 +429,8 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         body_v = body_from_world(self._velocity[envs], self._yaw[envs])
         state = self._obs["state"]
         state[envs, 0:3] = (self._position[envs] + noise[:, :3] - half) / half
+        # (w, x, y, z), scalar first: the policy's order. Not quat_from_yaw ([x, y, z, w], one
+        # yaw at a time with math.cos): numpy over the batch is what the policy was trained on.
         state[envs, 3] = np.cos(yaw / 2)
         state[envs, 4:6] = 0.0
         state[envs, 6] = np.sin(yaw / 2)

@@ -29,7 +29,8 @@ from seminspect.core.io import read_versioned_json, write_versioned_json
 from seminspect.core.rng import make_rng
 from seminspect.core.validation import build, describe_validation_error
 from seminspect.missions.learning.baselines import Controller
-from seminspect.missions.learning.env import EnvConfig, InspectionVectorEnv
+from seminspect.missions.learning.env import InspectionVectorEnv
+from seminspect.missions.learning.env_config import EnvConfig
 from seminspect.missions.learning.rooms import Room
 
 FORMAT = "seminspect.rl-evaluation"
@@ -185,36 +186,32 @@ def evaluate(
         threads: ray-casting threads of the environment.
         traces: if given, receives the first episode of each K for pictures.
     """
-    counts = _checked_counts(obstacle_counts)
-    if episodes < 1:
-        raise InvalidInputError(f"episodes must be >= 1, got {episodes}")
-    if num_envs < 1:
-        raise InvalidInputError(f"num_envs must be >= 1, got {num_envs}")
+    counts = _checked_protocol(obstacle_counts, episodes, num_envs)
     base = config or EnvConfig()
-    steps = base.steps_per_episode
-    total = len(counts) * episodes * steps
-    done = 0
+    total = len(counts) * episodes * base.steps_per_episode
     started = time.perf_counter()
     results = []
-    for obstacles in counts:
+    for index, obstacles in enumerate(counts):
         cfg = build(EnvConfig, {**base.model_dump(), "obstacles": obstacles}, "environment")
-        tally = _Tally()
-        for batch, first in enumerate(range(0, episodes, num_envs)):
-            size = min(num_envs, episodes - first)
-            record = traces is not None and batch == 0
-            env = InspectionVectorEnv(size, cfg, autoreset=False, record=record, threads=threads)
 
-            def advance(step: int, size=size, obstacles=obstacles, done=done) -> None:
-                if progress is not None:
-                    share = (done + step * size) / total
-                    progress(f"{obstacles} obstacles", share)
+        def advance(
+            steps: int,
+            before=index * episodes * cfg.steps_per_episode,
+            label=f"{obstacles} obstacles",
+        ) -> None:
+            if progress is not None:
+                progress(label, (before + steps) / total)
 
-            _run_batch(env, controller, batch_seed(seed, obstacles, batch), tally, advance)
-            done += size * steps
-            if record and traces is not None:
-                traces[obstacles] = EpisodeTrace(
-                    env.rooms[0], env.track(0), env.face_distances(0), tally.crashed[first]
-                )
+        tally = _run_count(
+            controller,
+            cfg,
+            episodes,
+            seed,
+            num_envs=num_envs,
+            threads=threads,
+            traces=traces,
+            advance=advance,
+        )
         results.append(_summarise(obstacles, tally, cfg))
     return EvaluationResult(
         policy=policy,
@@ -226,7 +223,8 @@ def evaluate(
     )
 
 
-def _checked_counts(obstacle_counts: Sequence[int]) -> list[int]:
+def _checked_protocol(obstacle_counts: Sequence[int], episodes: int, num_envs: int) -> list[int]:
+    """The obstacle counts, once the protocol is known to make sense."""
     counts = [int(k) for k in obstacle_counts]
     if not counts:
         raise InvalidInputError("give at least one obstacle count")
@@ -234,7 +232,43 @@ def _checked_counts(obstacle_counts: Sequence[int]) -> list[int]:
         raise InvalidInputError(f"obstacle counts must be >= 0, got {counts}")
     if len(set(counts)) != len(counts):
         raise InvalidInputError(f"obstacle counts repeat: {counts}")
+    if episodes < 1:
+        raise InvalidInputError(f"episodes must be >= 1, got {episodes}")
+    if num_envs < 1:
+        raise InvalidInputError(f"num_envs must be >= 1, got {num_envs}")
     return counts
+
+
+def _run_count(
+    controller: Controller,
+    config: EnvConfig,
+    episodes: int,
+    seed: int,
+    *,
+    num_envs: int,
+    threads: int,
+    traces: dict[int, EpisodeTrace] | None,
+    advance: Callable[[int], None],
+) -> _Tally:
+    """The ``episodes`` rooms of one obstacle count, in batches of at most ``num_envs`` rooms.
+
+    ``advance`` hears the room-steps done in this count; ``traces`` gets its first episode.
+    """
+    tally, obstacles = _Tally(), config.obstacles
+    for batch, first in enumerate(range(0, episodes, num_envs)):
+        size = min(num_envs, episodes - first)
+        record = traces is not None and batch == 0
+        env = InspectionVectorEnv(size, config, autoreset=False, record=record, threads=threads)
+
+        def advance_batch(step: int, before=first * config.steps_per_episode, size=size) -> None:
+            advance(before + step * size)
+
+        _run_batch(env, controller, batch_seed(seed, obstacles, batch), tally, advance_batch)
+        if record and traces is not None:
+            traces[obstacles] = EpisodeTrace(
+                env.rooms[0], env.track(0), env.face_distances(0), tally.crashed[0]
+            )
+    return tally
 
 
 def _run_batch(

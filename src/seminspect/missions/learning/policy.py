@@ -32,7 +32,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from torch import Tensor, nn
 
 from seminspect.core.errors import InvalidInputError
-from seminspect.missions.learning.env import ACTION_SIZE, STATE_SIZE, EnvConfig
+from seminspect.missions.learning.env_config import ACTION_SIZE, STATE_SIZE, EnvConfig
 
 #: Input shapes of one environment's observation with the default sensors (004 eq 4).
 DEPTH_SHAPE = (1, EnvConfig().image_size[1], EnvConfig().image_size[0])

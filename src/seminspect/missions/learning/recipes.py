@@ -10,9 +10,9 @@ from __future__ import annotations
 from typing import Literal
 
 from seminspect.core.errors import InvalidInputError
-from seminspect.missions.learning.env import EnvConfig
+from seminspect.missions.learning.env_config import EnvConfig
 from seminspect.missions.learning.policy import PolicyConfig
-from seminspect.missions.learning.ppo import TrainConfig
+from seminspect.missions.learning.train_config import TrainConfig
 
 #: Network variants: the main policy (GRU 128) and the ablations of Table II (no SVS map) and
 #: Table III (no GRU).

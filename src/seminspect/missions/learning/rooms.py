@@ -14,13 +14,14 @@ robot's clearance to everything in the room is exact and cheap (:func:`clearance
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cache
 
 import numpy as np
 from numpy.typing import NDArray
 
 from seminspect.core.errors import InvalidInputError
+from seminspect.geometry.transforms import matrix_from_euler_xyz
 from seminspect.worlds.shapes import Piece, box, cylinder, sphere
 
 #: Shape codes of :class:`Solids`.
@@ -45,6 +46,10 @@ class Solids:
     rotation: NDArray[np.float64]
     size: NDArray[np.float64]
 
+    def rows(self, index: NDArray[np.int64]) -> Solids:
+        """The solids of the rooms ``index`` of a batch (arrays with a leading room axis)."""
+        return Solids(self.kind[index], self.centre[index], self.rotation[index], self.size[index])
+
 
 @dataclass(frozen=True)
 class Room:
@@ -65,14 +70,6 @@ class Room:
     @property
     def obstacle_count(self) -> int:
         return len(self.solids.kind) - 1
-
-
-def _rotation(angles: NDArray[np.float64]) -> NDArray[np.float64]:
-    (ca, cb, cc), (sa, sb, sc) = np.cos(angles), np.sin(angles)
-    rx = np.array([[1, 0, 0], [0, ca, -sa], [0, sa, ca]])
-    ry = np.array([[cb, 0, sb], [0, 1, 0], [-sb, 0, cb]])
-    rz = np.array([[cc, -sc, 0], [sc, cc, 0], [0, 0, 1]])
-    return rz @ ry @ rx
 
 
 def clearance(
@@ -112,6 +109,23 @@ def stack_solids(rooms: list[Room]) -> Solids:
         kind[i, :n], centre[i, :n] = room.solids.kind, room.solids.centre
         rotation[i, :n], size[i, :n] = room.solids.rotation, room.solids.size
     return Solids(kind, centre, rotation, size)
+
+
+def side_by_side(
+    rooms: list[Room], spacing: float
+) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.int64]]:
+    """The triangles of every room in one scene, room ``i`` shifted by ``i * spacing`` along x.
+
+    Returns the vertices, the triangles and the target face of each triangle (-1: not the
+    target), as in :class:`Room`.
+    """
+    vertices, triangles, faces, base = [], [], [], 0
+    for i, room in enumerate(rooms):
+        vertices.append(room.vertices + np.array([i * spacing, 0.0, 0.0]))
+        triangles.append(room.triangles + base)
+        faces.append(room.face_of_triangle)
+        base += len(room.vertices)
+    return np.vstack(vertices), np.vstack(triangles), np.concatenate(faces)
 
 
 def _shell(size: NDArray) -> tuple[NDArray, NDArray]:
@@ -184,65 +198,97 @@ def sample_room(
     far from everything. The target stands ``orbit_gap`` from the walls where the room allows,
     so a robot can circle it at the reference distance.
     """
-    if obstacles < 0:
-        raise InvalidInputError(f"obstacle count must be >= 0, got {obstacles}")
-    extent = np.asarray(size, dtype=np.float64)
-    if extent.shape != (3,) or np.any(extent < (4.0, 4.0, 2.0)):
-        raise InvalidInputError(f"room must be at least 4 x 4 x 2 m, got {size}")
-    radius, height = rng.uniform(0.3, 0.8), rng.uniform(1.0, min(2.5, extent[2] - 1.0))
-    margin = np.minimum(radius + orbit_gap, extent[:2] / 2)
-    target_xy = rng.uniform(margin, extent[:2] - margin)
-    kinds, centres, rotations, sizes = [CYLINDER], [(*target_xy, height / 2)], [np.eye(3)], []
-    sizes.append(np.array([radius, height / 2, 0.0]))
-    verts: list[NDArray] = []
-    tris: list[NDArray] = []
-    tri_face: list[NDArray] = []
-    mesh = (verts, tris, tri_face)
-    t_verts, t_tris, t_faces = target_mesh(radius, height)
-    _append(mesh, t_verts + centres[0], t_tris, t_faces)
-    target_reach = math.hypot(radius, height / 2) + robot_clearance
+    extent = _checked_extent(obstacles, size)
+    parts = _RoomParts()
+    target_reach = _add_target(parts, rng, extent, orbit_gap) + robot_clearance
     for _ in range(obstacles):
-        kind, dims, o_verts, o_tris = _obstacle(rng)
-        reach = _bounding_radius(kind, dims)
-        for _attempt in range(32):
-            centre = rng.uniform(0.0, extent)
-            if np.linalg.norm(centre - centres[0]) > reach + target_reach:
-                break
-        rotation = _rotation(rng.uniform(-math.pi, math.pi, size=3))
-        kinds.append(kind)
-        centres.append(tuple(centre))
-        rotations.append(rotation)
-        sizes.append(dims)
-        _append(mesh, o_verts @ rotation.T + centre, o_tris, np.full(len(o_tris), -1))
-    s_verts, s_tris = _shell(extent)
-    _append(mesh, s_verts, s_tris, np.full(len(s_tris), -1))
-    solids = Solids(
-        kind=np.array(kinds, dtype=np.int8),
-        centre=np.array(centres, dtype=np.float64),
-        rotation=np.array(rotations, dtype=np.float64),
-        size=np.array(sizes, dtype=np.float64),
-    )
+        _add_obstacle(parts, rng, extent, target_reach)
+    parts.add_mesh(*_shell(extent))
+    solids = parts.solids()
     start = _free_start(rng, solids, extent, robot_clearance)
     return Room(
         size=extent,
         solids=solids,
-        vertices=np.vstack(verts),
-        triangles=np.vstack(tris),
-        face_of_triangle=np.concatenate(tri_face),
+        vertices=np.vstack(parts.vertices),
+        triangles=np.vstack(parts.triangles),
+        face_of_triangle=np.concatenate(parts.faces),
         start=start,
         start_yaw=float(rng.uniform(-math.pi, math.pi)),
     )
 
 
-def _append(
-    mesh: tuple[list, list, list], vertices: NDArray, tris: NDArray, faces: NDArray
+def _checked_extent(obstacles: int, size: tuple[float, float, float]) -> NDArray[np.float64]:
+    if obstacles < 0:
+        raise InvalidInputError(f"obstacle count must be >= 0, got {obstacles}")
+    extent = np.asarray(size, dtype=np.float64)
+    if extent.shape != (3,) or np.any(extent < (4.0, 4.0, 2.0)):
+        raise InvalidInputError(f"room must be at least 4 x 4 x 2 m, got {size}")
+    return extent
+
+
+@dataclass
+class _RoomParts:
+    """A room's solids and triangles as they are added: the target first, the shell last."""
+
+    kinds: list[int] = field(default_factory=list)
+    centres: list[NDArray[np.float64]] = field(default_factory=list)
+    rotations: list[NDArray[np.float64]] = field(default_factory=list)
+    sizes: list[NDArray[np.float64]] = field(default_factory=list)
+    vertices: list[NDArray[np.float64]] = field(default_factory=list)
+    triangles: list[NDArray[np.int64]] = field(default_factory=list)
+    faces: list[NDArray[np.int64]] = field(default_factory=list)
+
+    def add_solid(self, kind: int, centre: NDArray, rotation: NDArray, size: NDArray) -> None:
+        self.kinds.append(kind)
+        self.centres.append(centre)
+        self.rotations.append(rotation)
+        self.sizes.append(size)
+
+    def add_mesh(self, vertices: NDArray, triangles: NDArray, faces: NDArray | None = None) -> None:
+        """Triangles re-indexed after those already added; ``faces`` None: not the target."""
+        base = sum(len(x) for x in self.vertices)
+        self.vertices.append(np.asarray(vertices, dtype=np.float64))
+        self.triangles.append(np.asarray(triangles, dtype=np.int64) + base)
+        self.faces.append(
+            np.full(len(triangles), -1) if faces is None else np.asarray(faces, dtype=np.int64)
+        )
+
+    def solids(self) -> Solids:
+        return Solids(
+            kind=np.array(self.kinds, dtype=np.int8),
+            centre=np.array(self.centres, dtype=np.float64),
+            rotation=np.array(self.rotations, dtype=np.float64),
+            size=np.array(self.sizes, dtype=np.float64),
+        )
+
+
+def _add_target(
+    parts: _RoomParts, rng: np.random.Generator, extent: NDArray, orbit_gap: float
+) -> float:
+    """Place the semantic cylinder ``orbit_gap`` from the walls; returns its bounding radius."""
+    radius, height = rng.uniform(0.3, 0.8), rng.uniform(1.0, min(2.5, extent[2] - 1.0))
+    margin = np.minimum(radius + orbit_gap, extent[:2] / 2)
+    centre = np.array([*rng.uniform(margin, extent[:2] - margin), height / 2])
+    parts.add_solid(CYLINDER, centre, np.eye(3), np.array([radius, height / 2, 0.0]))
+    vertices, triangles, faces = target_mesh(radius, height)
+    parts.add_mesh(vertices + centre, triangles, faces)
+    return math.hypot(radius, height / 2)
+
+
+def _add_obstacle(
+    parts: _RoomParts, rng: np.random.Generator, extent: NDArray, target_reach: float
 ) -> None:
-    """Add a part to the room's (vertices, triangles, face ids) lists, re-indexing triangles."""
-    all_vertices, all_tris, all_faces = mesh
-    base = sum(len(x) for x in all_vertices)
-    all_vertices.append(np.asarray(vertices, dtype=np.float64))
-    all_tris.append(np.asarray(tris, dtype=np.int64) + base)
-    all_faces.append(np.asarray(faces, dtype=np.int64))
+    """A random primitive, placed (within 32 tries) so that it stays ``target_reach`` clear of
+    the target's centre; randomly turned."""
+    kind, size, vertices, triangles = _obstacle(rng)
+    needed = _bounding_radius(kind, size) + target_reach
+    for _attempt in range(32):
+        centre = rng.uniform(0.0, extent)
+        if np.linalg.norm(centre - parts.centres[0]) > needed:
+            break
+    rotation = matrix_from_euler_xyz(rng.uniform(-math.pi, math.pi, size=3))
+    parts.add_solid(kind, centre, rotation, size)
+    parts.add_mesh(vertices @ rotation.T + centre, triangles)
 
 
 def _free_start(

@@ -1,7 +1,8 @@
 """Routine inspection on an outdated map: the adaptive framework of 002, end to end.
 
-:func:`record_prior` drives a mapping traverse through the historical world and returns
-``M_H``. :class:`RoutineMission` then runs Algorithm 1 in the current world:
+:func:`~seminspect.missions.routine.prior.record_prior` drives a mapping traverse through the
+historical world and returns ``M_H``. :class:`RoutineMission` then runs Algorithm 1 in the
+current world, with the settings of :class:`~seminspect.missions.routine.config.RoutineConfig`:
 
 1. ``GenerateGlobalViewPlan``: the Fig 3 view grid of every region on ``M_H``
    (:mod:`~seminspect.planning.global_views`), poses in collision repaired or dropped.
@@ -27,28 +28,26 @@ from __future__ import annotations
 
 import itertools
 import math
-import os
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field
 
-from seminspect.core.errors import FileFormatError, PlanningError, SeminspectError
+from seminspect.core.errors import PlanningError, SeminspectError
 from seminspect.core.rng import make_rng
 from seminspect.geometry.depth_normals import viewpoint_utility
-from seminspect.geometry.transforms import quat_from_yaw
-from seminspect.mapping.voxel import OCCUPIED, VoxelMap, load_map
+from seminspect.mapping.voxel import VoxelMap
+from seminspect.missions.routine.config import RoutineConfig
 from seminspect.missions.routine.measures import (
     RANGE_TOLERANCE_M,
     region_samples,
     seen_samples,
     view_distance,
 )
+from seminspect.missions.routine.prior import SENSE_EVERY_M, make_robot, sense
 from seminspect.planning.adaptive_cycle import CycleDecision, plan_cycle
 from seminspect.planning.global_views import (
     InspectionRegion,
@@ -59,129 +58,12 @@ from seminspect.planning.global_views import (
 from seminspect.planning.gridmap import CostModel
 from seminspect.planning.routes import LocalPlanner
 from seminspect.planning.tour import annealed_tour, reference_tour
-from seminspect.planning.view_planner import ViewConstraints
-from seminspect.robot import Robot
-from seminspect.sensors import CameraModel, Frame, Lidar, render
-from seminspect.worlds import World
-from seminspect.worlds.routine_sites import DEFAULT_LENGTH, SitePair
+from seminspect.sensors import Frame, render
+from seminspect.worlds.routine_sites import SitePair
 
-#: Free-space clearing distance for LiDAR beams without a return [m].
-CLEAR_MISSES_M = 10.0
-#: Sensing interval while driving [m].
-SENSE_EVERY_M = 1.0
 #: Extra clearance planned around the robot's radius on M_C [m]: covers the voxel size and the
 #: conservative slack of the simulator's collision field.
 PLANNING_MARGIN_M = 0.3
-
-
-class RoutineConfig(BaseModel):
-    """Every setting of a routine mission (defaults: 002 Sec IV where it gives one)."""
-
-    model_config = ConfigDict(frozen=True, extra="forbid")
-
-    world: str = "mine-drift"
-    scenario: str = "nominal"
-    seed: int = Field(0, ge=0)
-    length: float = Field(DEFAULT_LENGTH, ge=10, le=200, description="drift length [m]")
-    adapt: bool = Field(True, description="Algorithm 1; False tracks the global tour directly")
-    d_view: float = Field(2.0, gt=0, description="desired viewing distance [m] (002: 2 m)")
-    overlap_h: float = Field(0.6, ge=0, lt=1, description="γ_H (002: 0.6)")
-    overlap_v: float = Field(0.6, ge=0, lt=1, description="γ_V (002 gives none; = γ_H)")
-    hfov_deg: float = Field(69.5, gt=0, lt=180, description="α (002: 69.5°)")
-    vfov_deg: float = Field(45.0, gt=0, lt=180, description="β (002: 45°)")
-    gamma_t: float = Field(0.5, gt=0, lt=1, description="Γ_t (002: 0.5)")
-    horizon: int = Field(3, ge=1, le=20, description="prediction horizon N (poses)")
-    map_resolution: float = Field(0.1, ge=0.05, le=0.5)
-    robot_radius: float = Field(0.3, gt=0)
-    speed: float = Field(0.5, gt=0, description="speed limit [m/s]")
-    z_limits: tuple[float, float] = (0.5, 4.0)
-    segment_m: float = Field(3.0, gt=0, description="navigation segment length [m]")
-    image_stride: int = Field(2, ge=1, le=8, description="render every n-th pixel for measures")
-
-    def view_constraints(self) -> ViewConstraints:
-        return ViewConstraints(
-            d_view=self.d_view,
-            overlap_h=self.overlap_h,
-            overlap_v=self.overlap_v,
-            hfov_deg=self.hfov_deg,
-            vfov_deg=self.vfov_deg,
-        )
-
-    def camera(self) -> CameraModel:
-        """A 640-pixel-wide camera whose height gives the vertical field of view β."""
-        fx = 320.0 / math.tan(math.radians(self.hfov_deg) / 2)
-        height = 2 * round(fx * math.tan(math.radians(self.vfov_deg) / 2))
-        return CameraModel(640, height, self.hfov_deg, 30.0)
-
-
-LIDAR = Lidar(beams=32, min_elevation_deg=-45.0, max_elevation_deg=45.0,
-              horizontal_resolution_deg=0.7, max_range=30.0)  # fmt: skip
-
-
-def make_robot(world: World, config: RoutineConfig) -> Robot:
-    low, high = config.z_limits
-    return Robot(
-        world,
-        "aerial",
-        radius=config.robot_radius,
-        body_height=1.5,
-        v_max=config.speed,
-        z_min=low,
-        z_max=high,
-    )
-
-
-def sense(robot: Robot, world: World, voxel_map: VoxelMap) -> NDArray[np.float64]:
-    """One LiDAR scan from the robot, integrated into ``voxel_map``; returns its points."""
-    scan = LIDAR.scan(world, robot.position, robot.quaternion, stamp=robot.time)
-    voxel_map.integrate_scan(scan, clear_misses_to=CLEAR_MISSES_M)
-    return scan.points
-
-
-def record_prior(
-    world: World, config: RoutineConfig, progress: Callable[[float], None] | None = None
-) -> VoxelMap:
-    """``M_H``: a traverse down the drift's centre line, a LiDAR scan and three camera frames
-    (ahead, left, right) integrated every metre. In a user's world the traverse runs along
-    +x from the start to 4 m short of the world's end, stopping where something blocks it."""
-    prior = VoxelMap.covering(world, config.map_resolution)
-    robot = make_robot(world, config)
-    camera = config.camera()
-    start = robot.position.copy()
-    end_x = float(world.metadata.get("face_x", world.bounds[1][0])) - 4.0
-    stops = np.arange(start[0], max(end_x, start[0]) + 1e-9, SENSE_EVERY_M)
-    for count, x in enumerate(stops):
-        if robot.move_to([x, start[1], start[2]], 0.0).blocked:
-            break
-        sense(robot, world, prior)
-        for yaw in (0.0, math.pi / 2, -math.pi / 2):
-            frame = render(world, camera, robot.position, quat_from_yaw(yaw), stride=4)
-            prior.integrate_frame(frame, stride=1)
-        if progress is not None:
-            progress((count + 1) / len(stops))
-    return prior
-
-
-def load_prior(path: str | os.PathLike[str], resolution: float) -> VoxelMap:
-    """A historical map from a file: a seminspect map (``.npz``), an OctoMap (``.bt``) or a
-    point cloud (``.ply``/``.pcd``: occupied cells, the rest unknown)."""
-    source = Path(path)
-    suffix = source.suffix.lower()
-    if suffix == ".npz":
-        return load_map(source)
-    if suffix == ".bt":
-        from seminspect.mapping.formats.octomap import load_octomap  # noqa: PLC0415 - optional extra
-
-        return load_octomap(source, resolution)
-    if suffix in (".ply", ".pcd"):
-        from seminspect.mapping.formats.pointfiles import load_point_file  # noqa: PLC0415 - rarely used
-
-        points = load_point_file(source).points
-        prior = VoxelMap.empty(points.min(axis=0) - 1.0, points.max(axis=0) + 1.0, resolution)
-        cells = prior.world_to_index(points)
-        prior.states[tuple(cells.T)] = OCCUPIED
-        return prior
-    raise FileFormatError(f"{source}: a prior map is .npz, .bt, .ply or .pcd")
 
 
 @dataclass(frozen=True)

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -30,25 +31,35 @@ from seminspect.core.errors import InvalidInputError
 from seminspect.core.interrupts import stop_on_signals
 from seminspect.core.io import atomic_write_text, write_versioned_json
 from seminspect.mapping.voxel import VoxelMap, save_map
-from seminspect.missions.routine.executive import (
-    RoutineConfig,
-    RoutineMission,
-    load_prior,
-    record_prior,
-    samples_table,
-)
+from seminspect.missions.routine.config import RoutineConfig
+from seminspect.missions.routine.executive import RoutineMission, samples_table
 from seminspect.missions.routine.measures import region_change
+from seminspect.missions.routine.metrics import (
+    METRICS_FORMAT,
+    RoutineMetrics,
+    RoutineScenario,
+    TaskFigures,
+)
+from seminspect.missions.routine.prior import load_prior, record_prior
 from seminspect.missions.routine.tasks import default_tasks, load_tasks
 from seminspect.planning.global_views import InspectionRegion
-from seminspect.runs.directory import ROUTINE_FILES, RunDirectory, RunEnd, conduct_run
+from seminspect.runs.conduct import RunEnd, conduct_run
+from seminspect.runs.directory import METRICS_FILE, RunDirectory, RunLayout
 from seminspect.worlds.routine_sites import SitePair, mine_drift_site
 
 TOUR_FORMAT = "seminspect.routine-tour"
+MAP_FILE = "map.npz"
 PRIOR_FILE = "prior/map.npz"
 #: The files a finished routine run holds (metrics last, as in a mission).
 ROUTINE_OUTPUTS = (
-    "map.npz", *ROUTINE_FILES, "trajectory.csv", "events.jsonl", "summary.md", "metrics.json",
+    MAP_FILE, "tour.json", "views.csv", "trajectory.csv", "events.jsonl", "summary.md",
+    METRICS_FILE,
 )  # fmt: skip
+ROUTINE_LAYOUT = RunLayout(
+    files=frozenset({MAP_FILE, "tour.json", "views.csv"}),
+    folders={"prior": re.compile(r"map\.npz")},
+    outputs=ROUTINE_OUTPUTS,
+)
 
 
 @dataclass
@@ -58,7 +69,7 @@ class RoutineResult:
     run_dir: Path
     state: str
     reason: str
-    metrics: dict[str, Any]
+    metrics: RoutineMetrics | None  # None when stopped before the mission was built
 
 
 def routine_site(config: RoutineConfig) -> SitePair:
@@ -80,10 +91,10 @@ def map_site(
     into ``out/map.npz``."""
     site = site if site is not None else routine_site(config)
     with stop_on_signals():
-        run = RunDirectory(out)
+        run = RunDirectory(out, ROUTINE_LAYOUT)
         with run.claimed({"routine_map": config.model_dump(mode="json")}):
             prior = record_prior(site.historical, config, progress)
-            path = run.write_map(prior)
+            path = save_map(run.path(MAP_FILE), prior)
             counts = prior.counts()
             run.write_summary(
                 f"# M_H of {config.world} {config.scenario}, seed {config.seed}\n\n"
@@ -117,7 +128,7 @@ def run_routine(
         "tasks": None if tasks_path is None else str(tasks_path),
     }
     with stop_on_signals():
-        run = RunDirectory(out)
+        run = RunDirectory(out, ROUTINE_LAYOUT)
         with run.claimed(settings):
             return _run_routine(
                 run, config, site, regions, prior_path=prior_path, progress=progress
@@ -135,7 +146,7 @@ def _run_routine(
 ) -> RoutineResult:
     started = time.perf_counter()
     mission: RoutineMission | None = None
-    metrics: dict[str, Any] = {}
+    metrics: RoutineMetrics | None = None
 
     def work() -> str:
         nonlocal mission
@@ -150,7 +161,7 @@ def _run_routine(
             metrics = routine_metrics(mission, site, end.state, end.reason, wall_s)
             _write_outputs(run, mission, metrics)
 
-    end = conduct_run(run, work, write_outputs, expected=ROUTINE_OUTPUTS, what="routine run")
+    end = conduct_run(run, work, write_outputs, expected=ROUTINE_LAYOUT.outputs, what="routine run")
     return RoutineResult(run.root, end.state, end.reason, metrics)
 
 
@@ -181,7 +192,7 @@ def _max(values: np.ndarray) -> float | None:
 
 def routine_metrics(
     mission: RoutineMission, site: SitePair, state: str, reason: str, wall_s: float
-) -> dict[str, Any]:
+) -> RoutineMetrics:
     """Every figure of a routine run (002 Sec V), with the change report per region."""
     table = samples_table(mission.samples)
     d_view = mission.config.d_view
@@ -191,40 +202,39 @@ def routine_metrics(
     coverage = [t.coverage_pct for t in mission.tasks if t.coverage_pct is not None]
     gaps = [t.tour["gap_pct"] for t in mission.tasks if "gap_pct" in t.tour]
     sim_time = mission.robot.time
-    return {
-        "state": state,
-        "stop_reason": reason,
-        "scenario": {"name": site.name, "seed": site.seed, "change": site.change},
-        "adaptive": mission.config.adapt,
-        "viewpoint_utility_mean": _mean(table["utility"].astype(float)),
-        "view_distance_mae_m": _mean(error),
-        "view_distance_mae_after_deviation_m": _mean(after),
-        "roi_coverage_pct": float(np.mean(coverage)) if coverage else None,
-        "tasks_completed": sum(t.completed for t in mission.tasks),
-        "tasks_total": len(mission.tasks),
-        "collisions": mission.collisions,
-        "gamma_s_max": _max(table["gamma_s"].astype(float)),
-        "gamma_s_mean": _mean(table["gamma_s"].astype(float)),
-        "adapted_cycles": int(table["adapted"].sum()) if len(table["adapted"]) else 0,
-        "cycles": len(mission.samples),
-        "rmse_before_kabsch_m": _mean(table["rmse_before_m"].astype(float)),
-        "rmse_after_kabsch_m": _mean(table["rmse_after_m"].astype(float)),
-        "planning_cycle_ms_mean": _mean(table["cycle_ms"].astype(float)),
-        "planning_cycle_ms_max": _max(table["cycle_ms"].astype(float)),
-        "tour_gap_pct_max": max(gaps) if gaps else None,
-        "sim_time_s": sim_time,
-        "wall_time_s": wall_s,
-        "real_time_factor": sim_time / wall_s if wall_s > 0 else None,
-        "tasks": [{**asdict(t), "time_s": t.time_s} for t in mission.tasks],
-        "change_report": [
-            asdict(region_change(plan.region, mission.prior, mission.current_map))
-            for plan in mission.plans
+    return RoutineMetrics(
+        state=state,
+        stop_reason=reason,
+        scenario=RoutineScenario(site.name, site.seed, site.change),
+        adaptive=mission.config.adapt,
+        viewpoint_utility_mean=_mean(table["utility"].astype(float)),
+        view_distance_mae_m=_mean(error),
+        view_distance_mae_after_deviation_m=_mean(after),
+        roi_coverage_pct=float(np.mean(coverage)) if coverage else None,
+        tasks_completed=sum(t.completed for t in mission.tasks),
+        tasks_total=len(mission.tasks),
+        collisions=mission.collisions,
+        gamma_s_max=_max(table["gamma_s"].astype(float)),
+        gamma_s_mean=_mean(table["gamma_s"].astype(float)),
+        adapted_cycles=int(table["adapted"].sum()) if len(table["adapted"]) else 0,
+        cycles=len(mission.samples),
+        rmse_before_kabsch_m=_mean(table["rmse_before_m"].astype(float)),
+        rmse_after_kabsch_m=_mean(table["rmse_after_m"].astype(float)),
+        planning_cycle_ms_mean=_mean(table["cycle_ms"].astype(float)),
+        planning_cycle_ms_max=_max(table["cycle_ms"].astype(float)),
+        tour_gap_pct_max=max(gaps) if gaps else None,
+        sim_time_s=sim_time,
+        wall_time_s=wall_s,
+        real_time_factor=sim_time / wall_s if wall_s > 0 else None,
+        tasks=[TaskFigures(**asdict(t), time_s=t.time_s) for t in mission.tasks],
+        change_report=[
+            region_change(plan.region, mission.prior, mission.current_map) for plan in mission.plans
         ],
-    }
+    )
 
 
-def _write_outputs(run: RunDirectory, mission: RoutineMission, metrics: dict[str, Any]) -> None:
-    run.write_map(mission.current_map)
+def _write_outputs(run: RunDirectory, mission: RoutineMission, metrics: RoutineMetrics) -> None:
+    save_map(run.path(MAP_FILE), mission.current_map)
     tours = [
         {
             "task": plan.region.name,
@@ -261,7 +271,7 @@ def _write_outputs(run: RunDirectory, mission: RoutineMission, metrics: dict[str
         )
     run.flush_events()
     run.write_summary(summary_markdown(metrics))
-    run.write_metrics(metrics)  # last: a reader takes metrics.json as the run's end
+    run.write_metrics(METRICS_FORMAT, metrics.to_json())  # last: it says the rest was written
 
 
 def _cell(value: Any) -> str:
@@ -276,37 +286,36 @@ def _fmt(value: float | None, unit: str = "", digits: int = 2) -> str:
     return "-" if value is None else f"{value:.{digits}f}{unit}"
 
 
-def summary_markdown(metrics: dict[str, Any]) -> str:
+def summary_markdown(metrics: RoutineMetrics) -> str:
     """The run's figures for people."""
-    scenario = metrics["scenario"]
-    mode = "adaptive (Algorithm 1)" if metrics["adaptive"] else "non-adaptive baseline"
+    scenario = metrics.scenario
+    mode = "adaptive (Algorithm 1)" if metrics.adaptive else "non-adaptive baseline"
     lines = [
-        f"# Routine inspection: mine drift, {scenario['name']}, seed {scenario['seed']}",
+        f"# Routine inspection: mine drift, {scenario.name}, seed {scenario.seed}",
         "",
-        f"{metrics['state']}: {metrics['stop_reason']}; {mode}; change: {scenario['change']}",
+        f"{metrics.state}: {metrics.stop_reason}; {mode}; change: {scenario.change}",
         "",
         "| measure | value |",
         "| --- | --- |",
-        f"| tasks completed | {metrics['tasks_completed']} / {metrics['tasks_total']} |",
-        f"| mean viewpoint utility | {_fmt(metrics['viewpoint_utility_mean'])} |",
-        f"| viewing-distance MAE | {_fmt(metrics['view_distance_mae_m'], ' m')} |",
-        f"| ROI coverage | {_fmt(metrics['roi_coverage_pct'], ' %', 1)} |",
-        f"| max Γ_s | {_fmt(metrics['gamma_s_max'])} |",
-        f"| adapted cycles | {metrics['adapted_cycles']} / {metrics['cycles']} |",
-        f"| RMSE before / after Kabsch | {_fmt(metrics['rmse_before_kabsch_m'], ' m')} / "
-        f"{_fmt(metrics['rmse_after_kabsch_m'], ' m')} |",
-        f"| collisions | {metrics['collisions']} |",
-        f"| simulated / wall time | {metrics['sim_time_s']:.0f} s / "
-        f"{metrics['wall_time_s']:.1f} s |",
+        f"| tasks completed | {metrics.tasks_completed} / {metrics.tasks_total} |",
+        f"| mean viewpoint utility | {_fmt(metrics.viewpoint_utility_mean)} |",
+        f"| viewing-distance MAE | {_fmt(metrics.view_distance_mae_m, ' m')} |",
+        f"| ROI coverage | {_fmt(metrics.roi_coverage_pct, ' %', 1)} |",
+        f"| max Γ_s | {_fmt(metrics.gamma_s_max)} |",
+        f"| adapted cycles | {metrics.adapted_cycles} / {metrics.cycles} |",
+        f"| RMSE before / after Kabsch | {_fmt(metrics.rmse_before_kabsch_m, ' m')} / "
+        f"{_fmt(metrics.rmse_after_kabsch_m, ' m')} |",
+        f"| collisions | {metrics.collisions} |",
+        f"| simulated / wall time | {metrics.sim_time_s:.0f} s / {metrics.wall_time_s:.1f} s |",
         "",
         "## Change between M_H and M_C per region",
         "",
         "| region | added m³ | removed m³ | compared m³ |",
         "| --- | --- | --- | --- |",
     ]
-    for change in metrics["change_report"]:
+    for change in metrics.change_report:
         lines.append(
-            f"| {change['region']} | {change['added_m3']:.2f} | {change['removed_m3']:.2f} | "
-            f"{change['compared_m3']:.2f} |"
+            f"| {change.region} | {change.added_m3:.2f} | {change.removed_m3:.2f} | "
+            f"{change.compared_m3:.2f} |"
         )
     return "\n".join(lines) + "\n"

@@ -40,6 +40,9 @@ from seminspect.core.errors import InvalidInputError, PlanningError
 from seminspect.core.validation import build
 from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.graphs.terrain.evaluate import (
+    ObjectQuality,
+    PlaceQuality,
+    TerrainQuality,
     match_boxes,
     match_class,
     predicted_boxes,
@@ -311,7 +314,7 @@ def evaluate_on_world(
     *,
     iou: float = 0.3,
     min_patch_area: float = 10.0,
-) -> dict[str, Any]:
+) -> TerrainQuality:
     """Score a phase-2 graph against the world it was mapped in (001 Sec IV, with ground truth).
 
     Objects: the nodes of each object prompt against the world's objects of the class the
@@ -321,28 +324,24 @@ def evaluate_on_world(
     and the share of the prompt's layer-1 points that lie on those patches.
     """
     scene = build.scene
-    objects: dict[str, Any] = {}
+    objects: dict[str, ObjectQuality] = {}
     object_classes = sorted({info.class_name for info in world.instances.values()})
     for prompt in scene.prompts.objects:
         match = match_class(encoder, prompt, object_classes, scene.calibration.objects)
         boxes = truth_boxes(world, match.truth) if match.truth else []
         scores = match_boxes(predicted_boxes(scene, prompt), boxes, iou)
-        objects[prompt] = {**match.as_dict(), **scores.as_dict()}
+        objects[prompt] = ObjectQuality(match, scores)
     patches = terrain_patches(world)
     terrain_classes = sorted({cls for cls, _ in patches})
-    places: dict[str, Any] = {}
+    places: dict[str, PlaceQuality] = {}
     for prompt in scene.prompts.terrain:
         match = match_class(encoder, prompt, terrain_classes, scene.calibration.terrain)
         mine = [polygon for cls, polygon in patches if cls == match.truth]
         place_scores = score_places(
             scene, prompt, mine, min_area=min_patch_area, tolerance=scene.params.cell_size
         )
-        places[prompt] = {
-            **match.as_dict(),
-            "points_on_terrain": _points_on(scene.layer1, prompt, mine),
-            **place_scores.as_dict(),
-        }
-    return {"objects": objects, "places": places}
+        places[prompt] = PlaceQuality(match, _points_on(scene.layer1, prompt, mine), place_scores)
+    return TerrainQuality(objects, places)
 
 
 def _points_on(layer: TaskPoints | None, prompt: str, patches: list[Polygon]) -> float | None:

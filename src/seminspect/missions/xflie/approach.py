@@ -25,10 +25,10 @@ from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.model import TargetNode, TargetStatus
 from seminspect.missions.xflie.config import ResolvedMissionConfig
 from seminspect.missions.xflie.context import MissionContext
-from seminspect.missions.xflie.navigation import RoutePlanner
 from seminspect.missions.xflie.sightings import register_targets, target_view
 from seminspect.planning.gridmap import CostModel
 from seminspect.planning.hierarchical import HierarchicalPlanner
+from seminspect.planning.protocols import RoutePlanner
 from seminspect.planning.routes import LocalPlanner
 from seminspect.planning.smoothing import refine_path
 from seminspect.planning.volumetric import RebuildingVolumetricPlanner

@@ -34,6 +34,7 @@ from seminspect.missions.xflie.config import ResolvedMissionConfig
 from seminspect.missions.xflie.context import MissionContext
 from seminspect.missions.xflie.exploration import Exploration
 from seminspect.missions.xflie.inspection import LevelInspection, platform_vfov
+from seminspect.missions.xflie.layout import write_graph
 from seminspect.missions.xflie.links import TargetLinks
 from seminspect.missions.xflie.metrics import CoverageRecorder
 from seminspect.missions.xflie.navigation import Navigator
@@ -107,8 +108,6 @@ class XFlie:
             lambda: platform.time, CoverageRecorder(config.inspection.d_view), run, name
         )
         self.local = local_planner(config)
-        #: The paper's baseline planner between targets (``planner="volumetric"``).
-        self.volumetric = baseline_planner(config)
         self.navigator = Navigator(
             platform,
             occupancy,
@@ -133,16 +132,24 @@ class XFlie:
             min_height=ground_z + GROUND_CLEARANCE,
             on_step=self._report,
         )
+        self.exploration = Exploration(self.ctx)
+        self._build_target_phases()
+
+    def _build_target_phases(self) -> None:
+        """The phases that reach, inspect and link targets (a mission that only explores
+        builds none)."""
+        inspection = self.config.inspection
         view = ViewConstraints(
-            d_view=config.inspection.d_view,
-            overlap_h=config.inspection.overlap_h,
-            overlap_v=config.inspection.overlap_v,
+            d_view=inspection.d_view,
+            overlap_h=inspection.overlap_h,
+            overlap_v=inspection.overlap_v,
             hfov_deg=self.params.fov_deg,
             vfov_deg=platform_vfov(self.params),
         )
-        self.exploration = Exploration(self.ctx)
+        #: The paper's baseline planner between targets (``planner="volumetric"``).
+        self.volumetric = baseline_planner(self.config)
         self.approach = Approach(self.ctx, self.planner, self.volumetric)
-        self.inspection = LevelInspection(self.ctx, view, platform.camera_pitch)
+        self.inspection = LevelInspection(self.ctx, view, self.platform.camera_pitch)
         self.links = TargetLinks(self.ctx, self.local)
 
     @property
@@ -220,7 +227,7 @@ class XFlie:
             levels=len(target.levels),
         )
         if self.run is not None:
-            self.run.write_graph(self.graph, snapshot_time=self.platform.time)
+            write_graph(self.run, self.graph, snapshot_time=self.platform.time)
             self.run.flush_events()
         if self.config.mode == "aerial":
             self.approach.descend(target)

@@ -59,6 +59,9 @@ class FrontierMission(XFlie):
         #: Whether frontiers are left that the time left cannot reach.
         self.budget_bound = False
 
+    def _build_target_phases(self) -> None:
+        """None: targets are registered as they are seen, never approached or inspected."""
+
     def execute(self) -> str:
         """Survey, then hop from frontier to frontier; returns why it stopped."""
         self._phase("explore-360")

@@ -17,7 +17,6 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -25,22 +24,14 @@ from numpy.typing import ArrayLike, NDArray
 from seminspect.core.errors import PlanningError
 from seminspect.mapping.voxel import FREE, OCCUPIED, UNKNOWN, VoxelMap
 from seminspect.missions.xflie.metrics import Timers
-from seminspect.planning.grid_astar import GridPath
 from seminspect.planning.gridmap import CostGrid
+from seminspect.planning.protocols import RoutePlanner
 from seminspect.planning.routes import LocalPlanner
 from seminspect.platform.protocol import Platform
 from seminspect.sensors import Frame, LidarScan
 
 #: Metres a goal may be missed by when the robot already stands within the goal radius plus this.
 ARRIVAL_SLACK = 0.05
-
-
-class RoutePlanner(Protocol):
-    """What the navigator asks of a planner: a route on the robot's current map."""
-
-    def plan(
-        self, voxel_map: VoxelMap, start: ArrayLike, goal: ArrayLike, goal_radius: float = 0.0
-    ) -> GridPath: ...
 
 
 @dataclass

@@ -24,8 +24,10 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from seminspect.core.errors import InvalidInputError
+from seminspect.geometry.transforms import yaw_rotation
 from seminspect.mapping.formats.rosbag import BagScan, write_bag
-from seminspect.runs.directory import load_run_world, load_trajectory
+from seminspect.missions.xflie.layout import load_run_world
+from seminspect.runs.trajectory import load_trajectory
 from seminspect.sensors.lidar import Lidar
 from seminspect.worlds import World
 
@@ -35,7 +37,7 @@ DEFAULT_SCAN_PERIOD_S = 1.0
 
 def _pose(x: float, y: float, z: float, yaw: float) -> NDArray[np.float64]:
     pose = np.eye(4)
-    pose[:3, :3] = Rotation.from_euler("z", yaw).as_matrix()
+    pose[:3, :3] = yaw_rotation(yaw).as_matrix()
     pose[:3, 3] = (x, y, z)
     return pose
 

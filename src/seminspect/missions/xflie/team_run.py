@@ -1,6 +1,6 @@
 """Running a two-robot mission (``robots = ("explorer", "inspector")``) into a run directory.
 
-The explorer and the inspector are built like the one robot of :mod:`.run` (same world, same
+The explorer and the inspector are built like the one robot of :mod:`.build` (same world, same
 start, same configuration; each has noise streams of its own) on one shared graph and one
 shared occupancy map, and :class:`~seminspect.missions.xflie.team.Team` interleaves them. The
 run directory holds what a one-robot run holds (``map.npz`` is the shared map,
@@ -16,8 +16,18 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, replace
 
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
+from seminspect.mapping.voxel import save_map
 from seminspect.missions.xflie import MissionProgress, XFlie
+from seminspect.missions.xflie.build import build_platform, mission_map
 from seminspect.missions.xflie.config import ResolvedMissionConfig
+from seminspect.missions.xflie.figures import (
+    graph_figures,
+    mission_figures,
+    quality_figures,
+    target_figures,
+    truth_targets,
+)
+from seminspect.missions.xflie.layout import MAP_FILE, METRICS_FORMAT, OUTPUT_FILES, write_graph
 from seminspect.missions.xflie.metrics import (
     CpuMeter,
     LevelEndings,
@@ -26,23 +36,14 @@ from seminspect.missions.xflie.metrics import (
     QueryAnswer,
     RunIdentity,
 )
-from seminspect.missions.xflie.run import (
-    MissionResult,
-    answer_queries,
-    build_platform,
-    graph_figures,
-    mission_figures,
-    mission_map,
-    quality_figures,
-    target_figures,
-    truth_targets,
-    write_graph_first,
-)
+from seminspect.missions.xflie.outputs import MissionResult, write_graph_first
+from seminspect.missions.xflie.queries import answer_queries
 from seminspect.missions.xflie.scoring import DEFAULT_GATE_M, score_targets
 from seminspect.missions.xflie.summary import summary_markdown
 from seminspect.missions.xflie.team import Activity, Team, TeamRobot
 from seminspect.planning.routes import warm_up
-from seminspect.runs.directory import OUTPUT_FILES, RunDirectory, RunEnd, conduct_run
+from seminspect.runs.conduct import RunEnd, conduct_run
+from seminspect.runs.directory import RunDirectory
 from seminspect.worlds import World
 
 
@@ -247,12 +248,12 @@ def _write_outputs(
     run: RunDirectory, team: Team, metrics: TeamMetrics, answers: Sequence[QueryAnswer]
 ) -> None:
     explorer, inspector = team.explorer.mission, team.inspector.mission
-    run.write_graph(inspector.graph)
-    run.write_map(explorer.occupancy)  # the map both robots built
+    write_graph(run, inspector.graph)
+    save_map(run.path(MAP_FILE), explorer.occupancy)  # the map both robots built
     run.write_trajectory(explorer.platform.trajectory_rows().tolist())
     for member in team.members:
         run.write_trajectory(member.mission.platform.trajectory_rows().tolist(), member.role)
     run.flush_events()
     summary = summary_markdown(metrics.team, inspector.graph, answers)
     run.write_summary(summary + "\n" + team_summary(metrics))
-    run.write_metrics(metrics.to_json())  # last: its presence says every output was written
+    run.write_metrics(METRICS_FORMAT, metrics.to_json())  # last: it says the rest was written

@@ -91,6 +91,11 @@ def load_evaluations(directory: Path) -> dict[str, EvaluationResult]:
     return {p.stem: EvaluationResult.from_json(p) for p in sorted(directory.glob("*.json"))}
 
 
+def table1_evaluations(results: Mapping[str, EvaluationResult]) -> dict[str, EvaluationResult]:
+    """The controllers of Table I (and of its coverage figure), by their policy label."""
+    return {results[n].policy: results[n] for n in NEEDS["rl-table1"]}
+
+
 def reproduction_sections(
     results: Mapping[str, EvaluationResult], wanted: set[str] | None = None
 ) -> dict[str, str]:
@@ -98,8 +103,7 @@ def reproduction_sections(
     wanted = set(SECTIONS) if wanted is None else wanted
     sections: dict[str, str] = {}
     if "rl-table1" in wanted:
-        rows = {results[n].policy: results[n] for n in NEEDS["rl-table1"]}
-        sections["rl-table1"] = table1_markdown(rows)
+        sections["rl-table1"] = table1_markdown(table1_evaluations(results))
     shipped = results["table1-learned"].at(ABLATION_OBSTACLES)
     if "rl-table2" in wanted:
         no_svs = results["ablation-no-svs"].at(ABLATION_OBSTACLES)

@@ -16,10 +16,11 @@ from seminspect.studies.learning.tables import (
     ablation_markdown,
     load_evaluations,
     reproduction_sections,
+    table1_evaluations,
     table1_markdown,
 )
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 SHORT = EnvConfig(episode_seconds=2.0)
 
 
@@ -51,6 +52,13 @@ def test_an_untrained_variant_says_so(results) -> None:
     text = ablation_markdown(PAPER_TABLE3, ours)
     assert "| coverage % | 004 | 59.8 | 63.6 | 74.6 |" in text
     assert text.count("not trained") == 3  # one per measure
+
+
+def test_table1_names_its_controllers_by_their_policy_label() -> None:
+    stored = load_evaluations(ROOT / "docs" / "data" / "rl")
+    rows = table1_evaluations(stored)
+    assert list(rows) == ["learned (shipped)", "orbit", "random"]
+    assert rows["orbit"] is stored["table1-orbit"]
 
 
 def test_published_tables_match_their_stored_evaluations() -> None:

@@ -1,0 +1,117 @@
+"""Sweeps of any program: the program's run and outcome make each row, groups get mean and
+spread, the tables are written, exclusive tasks run alone and a failure is one row."""
+
+import csv
+from pathlib import Path
+
+import pytest
+
+from seminspect.runs.sweep import (
+    Outcome,
+    SweepProgram,
+    SweepRow,
+    SweepTask,
+    _gather,
+    run_locally,
+    summarise,
+    sweep_tables,
+)
+
+COLUMNS = (("rmse_xy_m", "m"), ("sim_s", "s"))
+
+
+def _run(task: SweepTask) -> bool:
+    if task.name == "b":
+        raise ValueError(f"no run for {task.name}")
+    return True
+
+
+def _outcome(run_dir: Path) -> Outcome:
+    return "completed", {"rmse_xy_m": 0.25, "sim_s": 100.0}
+
+
+PROGRAM = SweepProgram(run=_run, outcome=_outcome, columns=COLUMNS)
+
+
+def _row(name: str, group: str, seed: int, rmse: float | None, state="completed") -> SweepRow:
+    figures = dict.fromkeys((c for c, _ in COLUMNS), None) | {"rmse_xy_m": rmse}
+    return SweepRow(name, group, seed, state, figures=figures)
+
+
+def test_groups_get_the_mean_and_spread_of_their_finished_runs(tmp_path) -> None:
+    rows = [
+        _row("a0", "a", 0, 0.1), _row("a1", "a", 1, 0.2), _row("a2", "a", 2, 0.3),
+        _row("a3", "a", 3, None, state="failed"), _row("b0", "b", 0, 0.5),
+    ]  # fmt: skip
+    a, b = summarise(rows, COLUMNS)
+    assert (a.group, a.runs, a.failed) == ("a", 4, 1)
+    assert a.mean["rmse_xy_m"] == pytest.approx(0.2)
+    assert a.spread["rmse_xy_m"] == pytest.approx(0.1)  # sample standard deviation of 0.1-0.3
+    assert b.mean["rmse_xy_m"] == 0.5 and b.spread["rmse_xy_m"] is None
+    written = sweep_tables(rows, tmp_path, COLUMNS)
+    assert [p.name for p in written] == ["sweep.csv", "sweep.json", "sweep.md"]
+    table = list(csv.DictReader(written[0].open()))
+    assert [r["run"] for r in table] == ["a0", "a1", "a2", "a3", "b0"]
+    assert table[3]["state"] == "failed" and table[3]["rmse_xy_m"] == ""
+    markdown = written[2].read_text()
+    assert "| a | 4 | 1 |" in markdown and "0.2 ± 0.1" in markdown
+
+
+class _FakeRay:
+    """Enough of Ray for the scheduler: tasks finish in the order they were started, and the
+    tasks in flight are recorded at every start."""
+
+    def __init__(self) -> None:
+        self.started: list[str] = []
+        self.in_flight: list[list[str]] = []
+        self._pending: list[tuple[int, SweepTask]] = []
+
+    def remote(self, **_options):
+        def wrap(function):
+            fake = self
+
+            class Remote:
+                @staticmethod
+                def remote(task: SweepTask, _program: SweepProgram) -> int:
+                    fake._pending.append((len(fake.started), task))
+                    fake.started.append(task.name)
+                    fake.in_flight.append([t.name for _, t in fake._pending])
+                    return len(fake.started) - 1
+
+            return Remote
+
+        return wrap
+
+    def wait(self, refs, num_returns):
+        assert num_returns == 1
+        return [min(refs)], []
+
+    def get(self, ref: int) -> SweepRow:
+        ((_, task),) = [entry for entry in self._pending if entry[0] == ref]
+        self._pending.remove((ref, task))
+        return SweepRow(task.name, task.group, task.seed, "completed")
+
+
+def _tasks(names: str, exclusive: bool) -> list[SweepTask]:
+    return [SweepTask(n, "g", {}, f"/nowhere/{n}", seed, exclusive) for seed, n in enumerate(names)]
+
+
+def test_exclusive_tasks_run_first_and_never_beside_each_other() -> None:
+    free, alone = _tasks("abc", exclusive=False), _tasks("xy", exclusive=True)
+    ray = _FakeRay()
+    rows = _gather(ray, free + alone, PROGRAM, None, slots=2)
+    assert [row.name for row in rows] == [t.name for t in free + alone]  # in the tasks' order
+    assert ray.started[0] == alone[0].name  # the exclusive chain never waits behind the others
+    alone_names = {t.name for t in alone}
+    assert all(len(set(names) & alone_names) <= 1 for names in ray.in_flight)
+    assert max(len(names) for names in ray.in_flight) == 2  # both slots are used
+
+
+def test_a_task_whose_run_fails_is_a_failed_row_naming_the_error(tmp_path) -> None:
+    (done,) = _tasks("d", exclusive=False)
+    (broken,) = _tasks("b", exclusive=False)
+    rows = run_locally([done, broken], PROGRAM)
+    assert [(r.state, r.reused, r.figures) for r in rows[:1]] == [
+        ("completed", True, {"rmse_xy_m": 0.25, "sim_s": 100.0})
+    ]
+    assert rows[1].state == "failed" and rows[1].error.startswith("ValueError: no run for b (")
