@@ -27,71 +27,81 @@ class PlannerChoice(str, Enum):
     frontier = "frontier"
 
 
+# The command's options, declared here so that its signature reads as a list of names.
+_WORLD_OPTION = typer.Option(
+    "city",
+    "--world",
+    "-w",
+    help="Built-in world (seminspect world list), or a user world: a folder with a mesh and "
+    "its labels file, as 'seminspect world export' writes.",
+)
+_SCENARIO_OPTION = typer.Option(
+    None, "--scenario", "-s", help="Scenario of the world (default: the world's; city: medium)."
+)
+_SEED_OPTION = typer.Option(0, "--seed", help="Seed of the world, sensors and robot.", min=0)
+_PRESET_OPTION = typer.Option(
+    None,
+    "--preset",
+    help="urban-simulated, urban-experimental or collapsed-buildings "
+    "(000 Tables 1-2); default: the world's.",
+)
+_MODE_OPTION = typer.Option(None, "--mode", help="ground or aerial; default: the world's.")
+_NOISE_OPTION = typer.Option(NoiseChoice.realistic, "--noise", help="Sensor noise preset.")
+_PLANNER_OPTION = typer.Option(
+    PlannerChoice.hierarchical,
+    "--planner",
+    help="hierarchical (3DLSG, the default), volumetric (the paper's baseline) or frontier "
+    "(pure exploration that never inspects: 000 Table 6's exploration baseline).",
+)
+_BUDGET_OPTION = typer.Option(
+    None, "--budget", help="Time budget in simulated seconds (default: 000 Sec VII-D's).", min=1
+)
+_CARVING_SPACING_OPTION = typer.Option(
+    None,
+    "--carving-spacing",
+    help="Approximate, faster mapping: near the sensor only rays this many cells apart "
+    "carve free space (default: every ray).",
+    min=0.01,
+    max=4.0,
+)
+_OUT_OPTION = typer.Option(None, "--out", "-o", help="Run directory (default: runs/<name>).")
+_QUERY_OPTION = typer.Option(
+    [], "--query", "-q", help="Operator query answered after the mission (repeatable)."
+)
+_PICTURES_OPTION = typer.Option(True, "--pictures/--no-pictures", help="Draw the run's pictures.")
+_RESUME_OPTION = typer.Option(
+    None,
+    "--resume",
+    help="Finish a run that was interrupted, failed or killed: run its configuration again "
+    "from the start into its directory (missions are deterministic).",
+)
+_BAG_OPTION = typer.Option(
+    None, "--bag", help="Replay the run's LiDAR stream into this new ROS2 bag (directory)."
+)
+_ROBOTS_OPTION = typer.Option(
+    None,
+    "--robots",
+    help="A team sharing one 3DLSG: 'explorer,inspector' (default: one robot does both).",
+)
+
+
 def app(
     ctx: typer.Context,
-    world: str = typer.Option(
-        "city",
-        "--world",
-        "-w",
-        help="Built-in world (seminspect world list), or a user world: a folder with a mesh and "
-        "its labels file, as 'seminspect world export' writes.",
-    ),
-    scenario: str | None = typer.Option(
-        None, "--scenario", "-s", help="Scenario of the world (default: the world's; city: medium)."
-    ),
-    seed: int = typer.Option(0, "--seed", help="Seed of the world, sensors and robot.", min=0),
-    preset: str | None = typer.Option(
-        None,
-        "--preset",
-        help="urban-simulated, urban-experimental or collapsed-buildings "
-        "(000 Tables 1-2); default: the world's.",
-    ),
-    mode: ModeChoice | None = typer.Option(
-        None, "--mode", help="ground or aerial; default: the world's."
-    ),
-    noise: NoiseChoice = typer.Option(
-        NoiseChoice.realistic, "--noise", help="Sensor noise preset."
-    ),
-    planner: PlannerChoice = typer.Option(
-        PlannerChoice.hierarchical,
-        "--planner",
-        help="hierarchical (3DLSG, the default), volumetric (the paper's baseline) or frontier "
-        "(pure exploration that never inspects: 000 Table 6's exploration baseline).",
-    ),
-    budget: float | None = typer.Option(
-        None, "--budget", help="Time budget in simulated seconds (default: 000 Sec VII-D's).", min=1
-    ),
-    carving_spacing: float | None = typer.Option(
-        None,
-        "--carving-spacing",
-        help="Approximate, faster mapping: near the sensor only rays this many cells apart "
-        "carve free space (default: every ray).",
-        min=0.01,
-        max=4.0,
-    ),
-    out: Path | None = typer.Option(
-        None, "--out", "-o", help="Run directory (default: runs/<name>)."
-    ),
-    query: list[str] = typer.Option(
-        [], "--query", "-q", help="Operator query answered after the mission (repeatable)."
-    ),
-    pictures: bool = typer.Option(
-        True, "--pictures/--no-pictures", help="Draw the run's pictures."
-    ),
-    resume: Path | None = typer.Option(
-        None,
-        "--resume",
-        help="Finish a run that was interrupted, failed or killed: run its configuration again "
-        "from the start into its directory (missions are deterministic).",
-    ),
-    bag: Path | None = typer.Option(
-        None, "--bag", help="Replay the run's LiDAR stream into this new ROS2 bag (directory)."
-    ),
-    robots: str | None = typer.Option(
-        None,
-        "--robots",
-        help="A team sharing one 3DLSG: 'explorer,inspector' (default: one robot does both).",
-    ),
+    world: str = _WORLD_OPTION,
+    scenario: str | None = _SCENARIO_OPTION,
+    seed: int = _SEED_OPTION,
+    preset: str | None = _PRESET_OPTION,
+    mode: ModeChoice | None = _MODE_OPTION,
+    noise: NoiseChoice = _NOISE_OPTION,
+    planner: PlannerChoice = _PLANNER_OPTION,
+    budget: float | None = _BUDGET_OPTION,
+    carving_spacing: float | None = _CARVING_SPACING_OPTION,
+    out: Path | None = _OUT_OPTION,
+    query: list[str] = _QUERY_OPTION,
+    pictures: bool = _PICTURES_OPTION,
+    resume: Path | None = _RESUME_OPTION,
+    bag: Path | None = _BAG_OPTION,
+    robots: str | None = _ROBOTS_OPTION,
 ) -> None:
     """Explore a site, inspect every target level by level and build its 3DLSG (paper 000).
 
@@ -119,11 +129,7 @@ def app(
             writable_directory(out)
     result = _run_with_progress(config, out, query)
     if pictures and result.stop_signal != signal.SIGTERM:  # SIGTERM asks to stop now
-        from seminspect.report.html import write_mission_report
-        from seminspect.report.run_pictures import render_run
-
-        render_run(result.run_dir)
-        write_mission_report(result.run_dir)
+        _draw_pictures(result.run_dir)
     if bag is not None and result.state == "completed":
         _export_bag(result.run_dir, bag)
     _print_result(result)
@@ -201,6 +207,14 @@ def _run_with_progress(config, out: Path | None, queries: list[str]):
             )
 
         return run_mission(config, out, queries=queries, progress=show)
+
+
+def _draw_pictures(run_dir: Path) -> None:
+    from seminspect.report.html import write_mission_report
+    from seminspect.report.run_pictures import render_run
+
+    render_run(run_dir)
+    write_mission_report(run_dir)
 
 
 def _export_bag(run_dir: Path, bag: Path) -> None:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -44,23 +46,34 @@ def parse_settings(items: list[str]) -> dict[str, list[Any]]:
     return settings
 
 
+# The command's options, declared here so that its signature reads as a list of names.
+_GRID_OPTION = typer.Option(
+    None, "--grid", help="YAML grid: worlds, scenarios, seeds, settings (see docs/sweeps.md)."
+)
+_WORLD_OPTION = typer.Option([], "--world", "-w", help="World (repeatable).")
+_SCENARIO_OPTION = typer.Option([], "--scenario", "-s", help="Scenario (repeatable).")
+_SEEDS_OPTION = typer.Option("0", "--seeds", help="Seeds, e.g. '0-4' or '0,2,5'.")
+_SET_OPTION = typer.Option(
+    [], "--set", help="Mission setting and its values, e.g. planner=hierarchical,volumetric."
+)
+_OUT_OPTION = typer.Option(Path("runs/sweep"), "--out", "-o", help="Sweep directory.")
+_WORKERS_OPTION = typer.Option(
+    None, "--workers", min=1, help="Local Ray workers (default: one per core)."
+)
+_ADDRESS_OPTION = typer.Option(
+    None, "--address", help="Address of a running Ray cluster (e.g. ray://head:10001)."
+)
+
+
 def app(
-    grid: Path | None = typer.Option(
-        None, "--grid", help="YAML grid: worlds, scenarios, seeds, settings (see docs/sweeps.md)."
-    ),
-    world: list[str] = typer.Option([], "--world", "-w", help="World (repeatable)."),
-    scenario: list[str] = typer.Option([], "--scenario", "-s", help="Scenario (repeatable)."),
-    seeds: str = typer.Option("0", "--seeds", help="Seeds, e.g. '0-4' or '0,2,5'."),
-    setting: list[str] = typer.Option(
-        [], "--set", help="Mission setting and its values, e.g. planner=hierarchical,volumetric."
-    ),
-    out: Path = typer.Option(Path("runs/sweep"), "--out", "-o", help="Sweep directory."),
-    workers: int | None = typer.Option(
-        None, "--workers", min=1, help="Local Ray workers (default: one per core)."
-    ),
-    address: str | None = typer.Option(
-        None, "--address", help="Address of a running Ray cluster (e.g. ray://head:10001)."
-    ),
+    grid: Path | None = _GRID_OPTION,
+    world: list[str] = _WORLD_OPTION,
+    scenario: list[str] = _SCENARIO_OPTION,
+    seeds: str = _SEEDS_OPTION,
+    setting: list[str] = _SET_OPTION,
+    out: Path = _OUT_OPTION,
+    workers: int | None = _WORKERS_OPTION,
+    address: str | None = _ADDRESS_OPTION,
 ) -> None:
     """Run every mission of a grid (worlds x scenarios x seeds x settings) as Ray tasks.
 
@@ -68,39 +81,12 @@ def app(
     configuration are reused; a failed mission is reported and the sweep goes on. Writes
     sweep.csv, sweep.json and sweep.md (per-run rows, mean and spread per group).
     """
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
-    from seminspect.core.errors import InvalidInputError
-    from seminspect.missions.xflie.sweep import MISSIONS, SweepSpec, expand, load_spec
+    from seminspect.missions.xflie.sweep import MISSIONS, expand
     from seminspect.runs.sweep import run_on_ray, sweep_tables
 
-    if grid is not None:
-        if world or scenario or setting:
-            raise InvalidInputError("give either --grid or --world/--scenario/--set, not both")
-        spec = load_spec(grid)
-    else:
-        spec = SweepSpec(
-            worlds=world or ["city"],
-            scenarios=list(scenario) or [None],
-            seeds=parse_seeds(seeds),
-            settings=parse_settings(setting),
-        )
-    tasks = expand(spec, out)
+    tasks = expand(_sweep_spec(grid, world, scenario, seeds, setting), out)
     out.mkdir(parents=True, exist_ok=True)
-    columns = (
-        TextColumn("[bold]sweep"), BarColumn(), MofNCompleteColumn(),
-        TextColumn("missions  {task.fields[failed]} failed  {task.fields[last]}"),
-        TimeElapsedColumn(),
-    )  # fmt: skip
-    with Progress(*columns, console=err_console, transient=True) as progress:
-        bar = progress.add_task("sweep", total=len(tasks), failed=0, last="")
-        failed = 0
-
-        def show(row) -> None:
-            nonlocal failed
-            failed += row.state == "failed"
-            progress.update(bar, advance=1, failed=failed, last=f"{row.name}: {row.state}")
-
+    with _sweep_progress(len(tasks)) as show:
         rows = run_on_ray(tasks, MISSIONS, workers=workers, address=address, on_row=show)
     written = sweep_tables(rows, out, MISSIONS.columns)
     console.print((out / "sweep.md").read_text(encoding="utf-8"), markup=False, highlight=False)
@@ -111,3 +97,44 @@ def app(
     if failures:
         err_console.print(f"{len(failures)} of {len(rows)} missions failed", highlight=False)
         raise typer.Exit(1)
+
+
+def _sweep_spec(
+    grid: Path | None, world: list[str], scenario: list[str], seeds: str, setting: list[str]
+):
+    """The grid of a YAML file, or of the command line's flags (not both)."""
+    from seminspect.core.errors import InvalidInputError
+    from seminspect.missions.xflie.sweep import SweepSpec, load_spec
+
+    if grid is not None:
+        if world or scenario or setting:
+            raise InvalidInputError("give either --grid or --world/--scenario/--set, not both")
+        return load_spec(grid)
+    return SweepSpec(
+        worlds=world or ["city"],
+        scenarios=list(scenario) or [None],
+        seeds=parse_seeds(seeds),
+        settings=parse_settings(setting),
+    )
+
+
+@contextlib.contextmanager
+def _sweep_progress(total: int) -> Iterator[Callable[[Any], None]]:
+    """A progress bar of finished and failed missions; yields the per-row callback."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    columns = (
+        TextColumn("[bold]sweep"), BarColumn(), MofNCompleteColumn(),
+        TextColumn("missions  {task.fields[failed]} failed  {task.fields[last]}"),
+        TimeElapsedColumn(),
+    )  # fmt: skip
+    with Progress(*columns, console=err_console, transient=True) as progress:
+        bar = progress.add_task("sweep", total=total, failed=0, last="")
+        failed = 0
+
+        def show(row) -> None:
+            nonlocal failed
+            failed += row.state == "failed"
+            progress.update(bar, advance=1, failed=failed, last=f"{row.name}: {row.state}")
+
+        yield show

@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
-from seminspect.missions.xflie.metrics import MissionMetrics, QueryAnswer
+from seminspect.missions.xflie.metrics import (
+    GraphFigures,
+    MissionMetrics,
+    QualityFigures,
+    QueryAnswer,
+)
 
 
 def _fmt(value: Any, digits: int = 2) -> str:
@@ -17,47 +22,55 @@ def _fmt(value: Any, digits: int = 2) -> str:
     return str(value)
 
 
+def _row(cells: Iterable[str]) -> str:
+    return "| " + " | ".join(cells) + " |"
+
+
 def summary_markdown(
     metrics: MissionMetrics, graph: LayeredSemanticGraph, answers: Sequence[QueryAnswer]
 ) -> str:
     """Table 3 and Table 6 columns, mission figures, queries and where the time went."""
-    t3, t6, m = metrics.table3, metrics.table6, metrics.mission
-    targets = metrics.targets
     world = metrics.world
-    pair = "/".join
-    lines = [
+    title = [
         f"# Mission: {world.name} {world.scenario or ''} (seed {world.seed})",
         "",
         f"State: **{metrics.state}** ({metrics.stop_reason})",
-        "",
+    ]
+    sections = [title, _graph_table(metrics.table3), _quality_table(metrics.table6)]
+    sections.append(_mission_figures(metrics))
+    if answers:
+        sections.append(_queries_table(answers))
+    sections.append(_targets_table(graph, metrics.table6.surface_coverage_by_target_pct))
+    return "\n\n".join("\n".join(lines) for lines in sections) + "\n"  # a blank line between
+
+
+def _graph_table(t3: GraphFigures) -> list[str]:
+    counts = (t3.target, t3.level, t3.pose, t3.feature, t3.total, t3.unified)
+    return [
         "## 3DLSG and inspection (000 Table 3 columns)",
         "",
         "| Target | Level | Pose | Feature | Total | Unified | Reconciled (%) "
         "| Detected / Inspected (%) | Avg. planning time (ms) |",
         "|---|---|---|---|---|---|---|---|---|",
-        "| "
-        + " | ".join(
+        _row(
             [
-                pair(map(str, t3.target)),
-                pair(map(str, t3.level)),
-                pair(map(str, t3.pose)),
-                pair(map(str, t3.feature)),
-                pair(map(str, t3.total)),
-                pair(map(str, t3.unified)),
+                *("/".join(map(str, pair)) for pair in counts),
                 _fmt(t3.reconciled_pct, 1),
                 f"{_fmt(t3.detected_pct, 1)} / {_fmt(t3.inspected_pct, 1)}",
                 _fmt(t3.avg_planning_time_ms, 4),
             ]
-        )
-        + " |",
-        "",
+        ),
+    ]
+
+
+def _quality_table(t6: QualityFigures) -> list[str]:
+    return [
         "## Quality (000 Table 6 columns)",
         "",
         "| CPU load (%) | Surface coverage (%) | Bounding-box volume (m^3) | of true boxes "
         "| RMSE xy (m) | RMSE 3D (m) |",
         "|---|---|---|---|---|---|",
-        "| "
-        + " | ".join(
+        _row(
             [
                 _fmt(t6.cpu_load_pct, 1),
                 _fmt(t6.surface_coverage_pct, 1),
@@ -66,9 +79,13 @@ def summary_markdown(
                 _fmt(t6.localisation_rmse_m, 3),
                 _fmt(t6.localisation_rmse_3d_m, 3),
             ]
-        )
-        + " |",
-        "",
+        ),
+    ]
+
+
+def _mission_figures(metrics: MissionMetrics) -> list[str]:
+    m, targets = metrics.mission, metrics.targets
+    return [
         "## Mission",
         "",
         f"- simulated time {_fmt(m.sim_time_s, 1)} s, wall time {_fmt(m.wall_time_s, 1)} s "
@@ -86,32 +103,35 @@ def summary_markdown(
         "Wall time by category (s): "
         + ", ".join(f"{k} {v:.1f}" for k, v in sorted(m.wall_time_by_category_s.items())),
     ]
-    if answers:
-        lines += [
-            "",
-            "## Operator queries",
-            "",
-            "| Query | Goal | Planning time (ms) | Path (m) | Reached within ε |",
-            "|---|---|---|---|---|",
-        ]
-        for a in answers:
-            time_ms = None if a.planning_time_s is None else 1e3 * a.planning_time_s
-            lines.append(
-                f"| {a.query} | {a.goal or a.error} | {_fmt(time_ms, 3)} | "
-                f"{_fmt(a.path_length_m, 1)} | {'yes' if a.reached else 'no'} |"
-            )
-    lines += [
+
+
+def _queries_table(answers: Sequence[QueryAnswer]) -> list[str]:
+    lines = [
+        "## Operator queries",
         "",
+        "| Query | Goal | Planning time (ms) | Path (m) | Reached within ε |",
+        "|---|---|---|---|---|",
+    ]
+    for a in answers:
+        time_ms = None if a.planning_time_s is None else 1e3 * a.planning_time_s
+        lines.append(
+            f"| {a.query} | {a.goal or a.error} | {_fmt(time_ms, 3)} | "
+            f"{_fmt(a.path_length_m, 1)} | {'yes' if a.reached else 'no'} |"
+        )
+    return lines
+
+
+def _targets_table(graph: LayeredSemanticGraph, coverage: Mapping[str, float]) -> list[str]:
+    lines = [
         "## Targets",
         "",
         "| Target | Status | Levels | Poses | Features | Surface coverage (%) |",
         "|---|---|---|---|---|---|",
     ]
-    coverage = t6.surface_coverage_by_target_pct
     for t in graph.targets():
         poses = [p for lv in t.levels for p in lv.poses]
         lines.append(
             f"| {t.id} | {t.status.value} | {len(t.levels)} | {len(poses)} | "
             f"{sum(len(p.features) for p in poses)} | {_fmt(coverage.get(t.id), 1)} |"
         )
-    return "\n".join(lines) + "\n"
+    return lines
