@@ -63,9 +63,9 @@ def test_a_signal_while_a_kernel_calls_back_into_numba_is_raised_when_it_returns
     ramp(3)
     for _ in range(10):  # raising at once failed nearly every time
         kill = threading.Timer(0.003, os.kill, (os.getpid(), signal.SIGTERM))
+        deadline = time.monotonic() + 5  # before the timer: the signal may land at once
         with stop_on_signals(), pytest.raises(Interrupted) as stopped:
             kill.start()
-            deadline = time.monotonic() + 5
             while time.monotonic() < deadline:
                 ramp(200_000)
         kill.join()
