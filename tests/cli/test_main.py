@@ -2,15 +2,20 @@
 
 import json
 import os
+import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from cli_runner import run
+from full_disk import fill_disk
 from seminspect.cli import _common as cli_common
 from seminspect.cli.graph import example_graph_path
 from seminspect.mapping.semantic_cloud import CLOUD_FORMAT
+from seminspect.missions.xflie.layout import XFLIE_LAYOUT
+from seminspect.runs.directory import clear_previous_run
+from seminspect.runs.status import read_run_status
 
 
 def _graph_with_version(tmp_path: Path, version: object) -> str:
@@ -196,3 +201,61 @@ def test_a_user_world_folder_works_where_a_name_does(capsys, tmp_path) -> None:
     assert code == 0, err
     config = json.loads((tmp_path / "run" / "config.json").read_text())["config"]
     assert config["world"] == str((tmp_path / "[/b]site").resolve()) and config["scenario"] is None
+
+
+def test_a_full_disk_fails_the_mission_in_one_line_naming_the_file(capsys, tmp_path, monkeypatch):
+    out = tmp_path / "run"
+    args = ("mission", "-w", "subterranean", "--budget", "5", "--no-pictures", "-o", str(out))
+    fill_disk(monkeypatch, "graph.json")
+    code, _, err = run(capsys, *args)
+    assert code == 1 and len(err.strip().splitlines()) == 1, err
+    assert "no space left on device, writing graph.json" in err and str(out) in err
+    status = read_run_status(out)
+    assert status.state == "failed" and "writing graph.json" in status.reason
+    monkeypatch.undo()
+    clear_previous_run(out, XFLIE_LAYOUT)  # what 'mission --out' does first: nothing refused
+
+
+def test_an_end_of_file_is_a_bug_not_a_ctrl_c(capsys, monkeypatch) -> None:
+    def truncated(*args, **kwargs):
+        raise EOFError("Ran out of input")
+
+    monkeypatch.setattr("seminspect.cli.graph.example_graph_path", truncated)
+    code, _, err = run(capsys, "graph", "show", "example")
+    assert code == 3 and err.startswith("internal error: EOFError: Ran out of input"), err
+
+
+@pytest.fixture
+def small_disk(tmp_path):
+    """``small_disk(size)``: a folder on a tmpfs of ``size`` (root only; skipped elsewhere)."""
+    mounted: list[Path] = []
+
+    def mount(size: str) -> Path:
+        folder = tmp_path / f"disk-{size}"
+        folder.mkdir()
+        if os.geteuid() != 0:
+            pytest.skip("mounting a small tmpfs needs root")
+        command = ["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(folder)]
+        if subprocess.run(command, check=False, capture_output=True).returncode != 0:
+            pytest.skip("mount cannot mount a tmpfs here")
+        mounted.append(folder)
+        return folder
+
+    yield mount
+    for folder in mounted:
+        subprocess.run(["umount", str(folder)], check=True)
+
+
+@pytest.mark.parametrize("size", ["4k", "12k"])
+def test_a_mission_on_a_small_disk_leaves_a_truthful_directory(capsys, small_disk, size) -> None:
+    out = small_disk(size) / "run"
+    args = ("mission", "-w", "subterranean", "--budget", "5", "--no-pictures", "-o", str(out))
+    code, _, err = run(capsys, *args)
+    assert code == 1 and len(err.strip().splitlines()) == 1, err
+    assert "no space left on device, writing " in err and str(out) in err
+    if (out / "status.json").exists():
+        status = read_run_status(out)
+        assert status.state == "failed" and "no space left on device, writing " in status.reason
+    else:  # not even the status fitted: the line says so
+        assert "could not record how the run ended" in err
+    clear_previous_run(out, XFLIE_LAYOUT)  # what 'mission --out' does first: nothing refused

@@ -52,3 +52,22 @@ def test_a_sweep_on_local_ray_writes_the_table_and_survives_a_failure(capsys, tm
     )  # fmt: skip
     again = json.loads((out / "sweep.json").read_text())["runs"]
     assert code == 0 and again[0]["reused"] is True
+
+
+def test_a_setting_given_twice_is_refused_naming_it() -> None:
+    with pytest.raises(InvalidInputError, match="--set gives time_budget_s twice"):
+        parse_settings(["time_budget_s=30", "planner=volumetric", "time_budget_s=60"])
+
+
+@pytest.mark.parametrize(
+    ("values", "message"),
+    [
+        ("time_budget_s=1,1.0", "repeats a mission"),  # one mission, flown twice
+        ("time_budget_s=true", "time_budget_s takes no true/false"),  # would pass as 1 s
+    ],
+)
+def test_values_that_pass_for_others_are_one_line(capsys, tmp_path, values, message) -> None:
+    out = tmp_path / "sweep"
+    code, _, err = run(capsys, "sweep", "--world", "campus", "--set", values, "--out", str(out))
+    assert code == 1 and message in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()  # refused before anything ran

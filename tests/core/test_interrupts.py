@@ -1,9 +1,15 @@
 import os
 import signal
+import time
 
 import pytest
 
-from seminspect.core.interrupts import Interrupted, deferred_signals, stop_on_signals
+from seminspect.core.interrupts import (
+    Interrupted,
+    as_interrupted,
+    deferred_signals,
+    stop_on_signals,
+)
 
 
 @pytest.mark.parametrize(("signum", "code"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
@@ -71,3 +77,24 @@ def test_a_signal_while_a_kernel_calls_back_into_numba_is_raised_when_it_returns
         kill.join()
         assert stopped.value.signum == signal.SIGTERM and time.monotonic() < deadline
         assert sys.getprofile() is None
+
+
+def test_a_library_that_swaps_a_sigterm_for_its_own_keyboard_interrupt_still_reads_sigterm() -> (
+    None
+):
+    # Ray catches the Interrupted of a signal during ray.wait and raises a bare KeyboardInterrupt
+    with stop_on_signals():
+        try:
+            try:
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(5)  # the handler raises here
+            except Interrupted:
+                raise KeyboardInterrupt from None
+        except KeyboardInterrupt as exc:
+            stop = as_interrupted(exc)
+    assert (stop.signum, stop.exit_code, stop.describe()) == (
+        signal.SIGTERM,
+        143,
+        "stopped by SIGTERM",
+    )
+    assert as_interrupted(KeyboardInterrupt()).signum == signal.SIGINT  # outside: a Ctrl-C

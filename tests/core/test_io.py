@@ -1,3 +1,4 @@
+import errno
 import json
 import os
 import stat
@@ -6,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from full_disk import fill_disk
 from seminspect.core.errors import FileFormatError
 from seminspect.core.io import (
     atomic_output,
@@ -96,3 +98,46 @@ def test_read_yaml_turns_every_broken_file_into_one_line(tmp_path) -> None:
         read_yaml(bad)
     with pytest.raises(FileFormatError, match="no such file"):
         read_yaml(tmp_path / "missing.yaml")
+
+
+def _write_with_a_third_party_writer(path: Path) -> None:
+    with atomic_output(path) as tmp:
+        tmp.write_bytes(b"new")
+
+
+@pytest.mark.parametrize(
+    "write",
+    [
+        lambda path: atomic_write_text(path, "new"),
+        lambda path: write_versioned_json(path, "kind", 1, {"x": 1}),
+        lambda path: save_npz_atomic(path, a=np.zeros(3)),
+        _write_with_a_third_party_writer,
+    ],
+    ids=["text", "versioned json", "npz", "third-party writer"],
+)
+def test_a_full_disk_names_the_file_and_keeps_the_old_one(tmp_path, monkeypatch, write) -> None:
+    path = atomic_write_text(tmp_path / "out.npz", "old")
+    fill_disk(monkeypatch, "out.npz")
+    with pytest.raises(OSError, match="No space left") as raised:
+        write(path)
+    assert raised.value.errno == errno.ENOSPC and raised.value.filename == str(path)
+    assert path.read_text() == "old" and sorted(tmp_path.iterdir()) == [path]  # no temporary
+
+
+def test_a_third_party_writers_error_about_another_file_keeps_its_name(tmp_path) -> None:
+    with pytest.raises(FileNotFoundError) as raised, atomic_output(tmp_path / "out.txt"):
+        (tmp_path / "missing.txt").read_text()
+    assert raised.value.filename == str(tmp_path / "missing.txt")
+
+
+def test_a_file_rewritten_in_place_needs_no_room_for_a_copy(tmp_path, monkeypatch) -> None:
+    from seminspect.core.io import rewrite_in_place
+
+    path = atomic_write_text(tmp_path / "status.json", "running")
+    fill_disk(monkeypatch)  # no room for a new file: its own blocks take the new bytes
+    rewrite_in_place(path, b"failed")
+    assert path.read_text() == "failed"
+    fill_disk(monkeypatch, in_place=True)
+    with pytest.raises(OSError, match="No space left") as raised:
+        rewrite_in_place(path, b"again")
+    assert raised.value.filename == str(path)

@@ -129,3 +129,17 @@ def test_camera_orientation_pitches_nose_down(world) -> None:
     robot = Robot(world, position=(0.0, 3.0, 0.7), yaw=math.pi / 2)
     forward = Rotation.from_quat(robot.camera_orientation(pitch=0.3)).apply([1.0, 0.0, 0.0])
     np.testing.assert_allclose(forward, [0.0, math.cos(0.3), -math.sin(0.3)], atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("mode", "start", "bounds"),
+    [
+        ("ground", (30.0, 0.0, 0.7), "x-y bounds are [-10.0, -5.0] to [10.0, 5.0]"),
+        ("aerial", (0.0, -7.5, 2.0), "bounds are [-10.0, -5.0, 0.0] to [10.0, 5.0, 5.0]"),
+    ],
+)
+def test_a_start_outside_the_world_says_so(world, mode, start, bounds) -> None:
+    with pytest.raises(InvalidInputError, match="outside the world 'box'") as caught:
+        Robot(world, mode=mode, position=start)
+    assert "obstacle" not in str(caught.value)
+    assert str(caught.value).endswith(bounds)

@@ -216,3 +216,25 @@ def test_an_image_that_cannot_be_written_fails_the_run_in_one_line(tmp_path) -> 
     with pytest.raises(SeminspectError, match="mission failed"), run.claimed(CONFIG):
         conduct_run(run, work, lambda end: None, expected=(), what="mission")
     assert read_run_status(run.root).state == "failed"
+
+
+def test_the_last_status_lists_the_cached_arrays_the_run_used(tmp_path, monkeypatch) -> None:
+    from seminspect.core.cache import CACHE_ENV, array_key, cached_array
+
+    monkeypatch.setenv(CACHE_ENV, str(tmp_path / "cache"))
+    key = array_key("a grid's inputs")
+
+    def one_run(name: str, uses_cache: bool) -> list[dict[str, str]]:
+        run = RunDirectory(tmp_path / name, LAYOUT)
+        with run.claimed(CONFIG):
+            if uses_cache:
+                cached_array("collision", key, lambda: np.arange(6.0))
+            run.finish("completed")
+        status = json.loads(run.path("status.json").read_text())
+        return status["cache_entries"]
+
+    assert [e["outcome"] for e in one_run("first", True)] == ["stored"]
+    assert [(e["kind"], e["key"], e["outcome"]) for e in one_run("second", True)] == [
+        ("collision", key, "hit")
+    ]
+    assert one_run("third", False) == []  # an earlier run's entries are not this one's

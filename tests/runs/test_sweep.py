@@ -1,18 +1,26 @@
 """Sweeps of any program: the program's run and outcome make each row, groups get mean and
-spread, the tables are written, exclusive tasks run alone and a failure is one row."""
+spread, the tables are written, exclusive tasks run alone and a failure is one row; a stopped
+sweep keeps its finished rows, marks the others interrupted and writes partial tables."""
 
 import csv
+import json
+import signal
 from pathlib import Path
 
 import pytest
 
+from seminspect.core.interrupts import Interrupted
 from seminspect.runs.sweep import (
+    CANCEL_GRACE_S,
     Outcome,
+    SweepInterrupted,
     SweepProgram,
     SweepRow,
     SweepTask,
     _gather,
+    remove_tables,
     run_locally,
+    run_on_ray,
     summarise,
     sweep_tables,
 )
@@ -115,3 +123,109 @@ def test_a_task_whose_run_fails_is_a_failed_row_naming_the_error(tmp_path) -> No
         ("completed", True, {"rmse_xy_m": 0.25, "sim_s": 100.0})
     ]
     assert rows[1].state == "failed" and rows[1].error.startswith("ValueError: no run for b (")
+
+
+def _stop_at(name: str, stop: KeyboardInterrupt):
+    """A program whose run of task ``name`` is cut short by ``stop``."""
+
+    def run(task: SweepTask) -> bool:
+        if task.name == name:
+            raise stop
+        return True
+
+    return SweepProgram(run=run, outcome=_outcome, columns=COLUMNS)
+
+
+@pytest.mark.parametrize(
+    ("stop", "signum"),
+    [(KeyboardInterrupt(), signal.SIGINT), (Interrupted(signal.SIGTERM), signal.SIGTERM)],
+)
+def test_a_stopped_local_sweep_keeps_its_finished_rows(stop, signum) -> None:
+    tasks = _tasks("abc", exclusive=False)
+    with pytest.raises(SweepInterrupted) as raised:
+        run_locally(tasks, _stop_at("b", stop))
+    assert raised.value.signum == signum and raised.value.exit_code == 128 + signum
+    assert [(r.name, r.state) for r in raised.value.rows] == [
+        ("a", "completed"), ("b", "interrupted"), ("c", "interrupted"),
+    ]  # fmt: skip
+    assert raised.value.rows[2].error == f"not finished: {Interrupted(signum).describe()}"
+
+
+def test_a_stopped_sweeps_tables_are_marked_partial(tmp_path) -> None:
+    rows = [_row("a0", "a", 0, 0.1), _row("a1", "a", 1, 0.3)]
+    rows.append(SweepRow("a2", "a", 2, "interrupted", error="not finished: stopped by SIGTERM"))
+    csv_file, json_file, md_file = sweep_tables(rows, tmp_path, COLUMNS, "stopped by SIGTERM")
+    document = json.loads(json_file.read_text())
+    assert document["partial"] is True and document["stopped"] == "stopped by SIGTERM"
+    (group,) = document["groups"]
+    assert (group["runs"], group["failed"]) == (2, 0)  # a run that never ran is in no group
+    assert group["mean"]["rmse_xy_m"] == pytest.approx(0.2)
+    assert md_file.read_text().startswith("**Partial table**: the sweep was stopped by SIGTERM;")
+    assert "2 of 3 runs finished" in md_file.read_text()
+    table = list(csv.DictReader(csv_file.open()))
+    assert table[2]["state"] == "interrupted" and "SIGTERM" in table[2]["error"]
+    # a complete sweep's tables say nothing of it
+    sweep_tables(rows[:2], tmp_path, COLUMNS)
+    assert "partial" not in json.loads(json_file.read_text())
+    assert "Partial" not in md_file.read_text()
+
+
+def test_an_earlier_sweeps_tables_are_removed(tmp_path) -> None:
+    written = sweep_tables([_row("a0", "a", 0, 0.1)], tmp_path, COLUMNS)
+    (tmp_path / "a0").mkdir()
+    remove_tables(tmp_path)
+    assert not any(path.exists() for path in written) and (tmp_path / "a0").is_dir()
+
+
+class _StoppedRay(_FakeRay):
+    """A Ray whose first wait is cut short by Ctrl-C; the tasks in flight are cancelled and
+    the first of them still ends within the grace."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.cancelled: list[int] = []
+        self.grace: float | None = None
+
+    def wait(self, refs, num_returns, timeout=None):
+        if not self.cancelled:
+            raise KeyboardInterrupt
+        self.grace = timeout
+        return [min(refs)], [max(refs)]
+
+    def cancel(self, ref: int) -> None:
+        self.cancelled.append(ref)
+
+
+def test_a_stopped_ray_sweep_cancels_its_tasks_and_keeps_those_that_ended() -> None:
+    ray = _StoppedRay()
+    with pytest.raises(SweepInterrupted) as raised:
+        _gather(ray, _tasks("abc", exclusive=False), PROGRAM, None, slots=2)
+    assert sorted(ray.cancelled) == [0, 1] and ray.grace == CANCEL_GRACE_S
+    assert [r.state for r in raised.value.rows] == ["completed", "interrupted", "interrupted"]
+    assert raised.value.signum == signal.SIGINT
+
+
+def test_ray_init_does_not_keep_its_own_stop_handlers(monkeypatch) -> None:
+    class InitRay(_FakeRay):
+        def is_initialized(self) -> bool:
+            return False
+
+        def init(self, **_options) -> None:  # Ray's: exits 1, and its native one dumps stacks
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+        def cluster_resources(self) -> dict[str, float]:
+            return {"CPU": 1.0}
+
+        def shutdown(self) -> None:
+            pass
+
+    def ours(signum, frame) -> None:
+        raise AssertionError("not called")
+
+    monkeypatch.setattr("seminspect.runs.sweep._ray", InitRay)
+    previous = signal.signal(signal.SIGTERM, ours)
+    try:
+        run_on_ray(_tasks("a", exclusive=False), PROGRAM, workers=1)
+        assert signal.getsignal(signal.SIGTERM) is ours
+    finally:
+        signal.signal(signal.SIGTERM, previous)

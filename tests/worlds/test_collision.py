@@ -1,10 +1,12 @@
 import math
+import zipfile
 
 import numpy as np
 import pytest
 
-from seminspect.core.cache import CACHE_ENV
+from seminspect.core.cache import CACHE_ENV, CacheWarning
 from seminspect.core.errors import InvalidInputError
+from seminspect.worlds.collision import CollisionField, check_grid_sizes
 from sim_worlds import box_world
 
 BOX_LO, BOX_HI = np.array([4.0, -1.0, 0.0]), np.array([6.0, 1.0, 2.0])
@@ -102,3 +104,58 @@ def test_a_changed_world_misses_the_cache(tmp_path, monkeypatch) -> None:
     np.testing.assert_array_equal(
         taller.distance, box_world(upper=(6.0, 1.0, 2.5)).collision.grid("ground").distance
     )
+
+
+def _flip_values(path) -> None:
+    data = bytearray(path.read_bytes())
+    middle = len(data) // 2
+    data[middle : middle + 64] = bytes(b ^ 0x5A for b in data[middle : middle + 64])
+    path.write_bytes(bytes(data))
+
+
+def _zip_in_place(path) -> None:
+    with zipfile.ZipFile(path, "w") as archive:
+        archive.writestr("arr_0.npy", b"not the grid")
+
+
+DAMAGES = {
+    "flipped bytes": _flip_values,
+    "empty": lambda path: path.write_bytes(b""),
+    "zip": _zip_in_place,
+    "wrong shape": lambda path: np.save(path, np.ones((10, 10), dtype=np.float32)),
+}
+
+
+@pytest.mark.parametrize("damage", DAMAGES.values(), ids=DAMAGES.keys())
+@pytest.mark.parametrize("mode", ["ground", "aerial"])
+def test_a_damaged_cached_grid_is_rebuilt_as_a_clean_build(mode, damage, tmp_path, monkeypatch):
+    monkeypatch.setenv(CACHE_ENV, "off")
+    fresh = box_world().collision.grid(mode)
+    monkeypatch.setenv(CACHE_ENV, str(tmp_path))
+    box_world().collision.grid(mode)  # builds and stores
+    (stored,) = (tmp_path / "collision").iterdir()
+    damage(stored)
+    with pytest.warns(CacheWarning, match="damaged cache entry"):
+        rebuilt = box_world().collision.grid(mode)
+    again = box_world().collision.grid(mode)  # the replacement reads back sound
+    for grid in (rebuilt, again):
+        assert grid.distance.dtype == fresh.distance.dtype
+        np.testing.assert_array_equal(grid.distance, fresh.distance)
+
+
+def test_a_world_too_large_for_its_grids_is_refused_before_allocating() -> None:
+    bounds = np.array([[0.0, 0.0, 0.0], [2e6, 2e6, 10.0]])
+    triangles = np.zeros((1, 3, 3))
+    with pytest.raises(InvalidInputError, match=r"ground collision grid would have 1\.6e\+15"):
+        CollisionField(triangles, np.zeros(1, np.int32), np.zeros(1, bool), bounds, ground_z=0.0)
+    with pytest.raises(InvalidInputError, match=r"aerial collision grid .* at 1 m"):
+        check_grid_sizes(np.array([[0.0, 0.0, 0.0], [1e4, 1e4, 10.0]]), ground_resolution=10.0)
+    with pytest.raises(InvalidInputError, match="not finite"):
+        check_grid_sizes(np.array([[0.0, 0.0, 0.0], [np.inf, 1.0, 1.0]]))
+
+
+def test_every_built_in_world_fits_the_grid_bound_by_far() -> None:
+    city = np.array([[0.0, 0.0, 0.0], [150.0, 100.0, 5.0]])  # the largest built-in world
+    check_grid_sizes(city * 5.0)  # 750 x 500 m: 150 M ground cells, under the bound
+    with pytest.raises(InvalidInputError):
+        check_grid_sizes(city * 6.0)

@@ -1,5 +1,6 @@
 import json
 import math
+import time
 from pathlib import Path
 
 import numpy as np
@@ -284,3 +285,20 @@ def test_a_world_path_names_a_folder_a_labels_file_or_a_mesh(tmp_path) -> None:
         open_world(str(folder))
     with pytest.raises(FileFormatError, match="no such world file"):
         open_world(str(tmp_path / "gone"))
+
+
+def test_a_world_at_the_wrong_scale_is_refused_before_its_grids(cube_files) -> None:
+    """A mesh in metres labelled as micrometres: 35 s to a MemoryError before this check."""
+    mesh, labels = cube_files
+    document = _labels(scale=1e6)
+    document["labels"] = document["labels"][:2]  # the lid's box is in metres
+    labels.write_text(yaml.safe_dump(document))
+    started = time.perf_counter()
+    with pytest.raises(FileFormatError) as caught:
+        load_world(mesh, labels)
+    assert time.perf_counter() - started < 5.0
+    message = str(caught.value)
+    assert message.startswith(f"{labels}: the world is 1e+06 x 1e+06 x")
+    assert "ground collision grid would have 4e+14 cells at 0.05 m" in message
+    assert "'scale: 1e+06'" in message and "smaller scale" in message
+    assert "\n" not in message

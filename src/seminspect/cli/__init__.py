@@ -3,7 +3,8 @@
 Each command group lives in its own module and is registered in :data:`GROUPS`. Errors a user
 can cause (:class:`~seminspect.core.errors.SeminspectError`) become one line on stderr and exit
 code 1; an unexpected exception becomes one line too, with the traceback behind ``--debug``.
-Ctrl-C and SIGTERM stop any command with exit code 130 and 143. User text is printed as typed.
+Ctrl-C and SIGTERM stop any command with one line saying which (``interrupted by the operator
+(Ctrl-C)``, ``stopped by SIGTERM``) and exit code 130 and 143. User text is printed as typed.
 """
 
 from __future__ import annotations
@@ -17,12 +18,13 @@ from collections.abc import Iterator, Sequence
 from typing import Any
 
 import typer
+import typer.core
 from pydantic import ValidationError
 
 from seminspect import __version__
 from seminspect.cli._common import err_console, labelled
 from seminspect.core.errors import SeminspectError
-from seminspect.core.interrupts import Interrupted, as_interrupted, stop_on_signals
+from seminspect.core.interrupts import as_interrupted, stop_on_signals
 from seminspect.core.validation import describe_validation_error
 
 #: Typer ships its own click; take its usage-error class from a public exception's ancestry.
@@ -42,7 +44,42 @@ GROUPS: tuple[tuple[str, str, str], ...] = (
     ("view", "view", "Open a run's report.html (3D graph, tables, plots) in the browser."),
 )
 
+
+class _CarriedError(Exception):
+    """A stop signal or an ``EOFError`` on its way past click to :func:`_report`."""
+
+    def __init__(self, original: KeyboardInterrupt | EOFError) -> None:
+        super().__init__(original)
+        self.original = original
+
+
+@contextlib.contextmanager
+def _past_click() -> Iterator[None]:
+    try:
+        yield
+    except (KeyboardInterrupt, EOFError) as exc:
+        raise _CarriedError(exc) from exc
+
+
+class _RootGroup(typer.core.TyperGroup):
+    """The root command, whose parsing and invocation wrap every command's.
+
+    Typer turns ``KeyboardInterrupt`` into a silent exit 130 (losing which signal it was) and
+    ``EOFError`` into ``Abort`` after printing a newline (an unexpected end of a file then reads
+    as Ctrl-C); both are carried past it unchanged instead.
+    """
+
+    def make_context(self, *args: Any, **kwargs: Any) -> Any:
+        with _past_click():
+            return super().make_context(*args, **kwargs)
+
+    def invoke(self, ctx: Any) -> Any:
+        with _past_click():
+            return super().invoke(ctx)
+
+
 app = typer.Typer(
+    cls=_RootGroup,
     name="seminspect",
     help="Semantic-aware autonomous inspection: scene graphs, simulated worlds, missions.",
     no_args_is_help=True,
@@ -101,11 +138,12 @@ def main(argv: Sequence[str] | None = None) -> None:
 def _run_app(args: list[str], debug: bool) -> int:
     """The exit code of the app on ``args``, every error reported in one line."""
     try:
-        result = app(args=args, prog_name="seminspect", standalone_mode=False)
+        try:
+            result = app(args=args, prog_name="seminspect", standalone_mode=False)
+        except _CarriedError as carried:
+            raise carried.original from None
     except (Exception, KeyboardInterrupt) as exc:
-        if debug and not isinstance(
-            exc, typer.Exit | typer.Abort | _USAGE_ERROR | KeyboardInterrupt
-        ):
+        if debug and not isinstance(exc, typer.Exit | _USAGE_ERROR | KeyboardInterrupt):
             raise
         return _report(exc)
     # typer returns a command's exit code in non-standalone mode instead of exiting
@@ -121,8 +159,8 @@ def _report(exc: BaseException) -> int:
         if code:
             command = exc.ctx.command_path if exc.ctx else "seminspect"
             _error("error:", f"{exc.format_message()} (see '{command} --help')")
-    elif isinstance(exc, KeyboardInterrupt | typer.Abort):
-        stop = as_interrupted(exc) if isinstance(exc, KeyboardInterrupt) else Interrupted()
+    elif isinstance(exc, KeyboardInterrupt):
+        stop = as_interrupted(exc)
         err_console.print(stop.describe(), highlight=False)
         code = stop.exit_code
     elif isinstance(exc, SeminspectError | ValidationError):

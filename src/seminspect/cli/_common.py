@@ -1,4 +1,5 @@
-"""Consoles shared by the command groups, and the checks every command makes of its outputs.
+"""Consoles shared by the command groups, the checks every command makes of its outputs, and
+how a command that saved its partial results after a stop signal ends.
 
 The consoles do not interpret rich markup: what a user typed (a query, a path, a node name)
 is printed as typed, ``[/b]`` included. Styled words are built with :class:`rich.text.Text`.
@@ -7,12 +8,16 @@ is printed as typed, ``[/b]`` included. Styled words are built with :class:`rich
 from __future__ import annotations
 
 import os
+import signal
 from pathlib import Path
+from typing import NoReturn
 
+import typer
 from rich.console import Console
 from rich.text import Text
 
 from seminspect.core.errors import InvalidInputError
+from seminspect.core.interrupts import Interrupted
 
 console = Console(markup=False)
 err_console = Console(stderr=True, markup=False)
@@ -34,6 +39,15 @@ def progress_bar():
         console=err_console,
         transient=True,
     )
+
+
+def exit_stopped(signum: int | None, partial: Path) -> NoReturn:
+    """End a command whose work a stop signal cut short once its partial results are saved:
+    the line and the exit code (128 plus the signal) every stopped command ends with."""
+    stop = Interrupted(signum or signal.SIGINT)
+    message = f"{stop.describe()}; partial results in {partial}"
+    err_console.print(message, highlight=False, soft_wrap=True)
+    raise typer.Exit(stop.exit_code)
 
 
 def writable_file(path: Path, suffixes: tuple[str, ...] = ()) -> Path:

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import typer
 
-from seminspect.cli._common import console, err_console, labelled, writable_directory
+from seminspect.cli._common import console, err_console, exit_stopped, labelled, writable_directory
 
 
 class ModeChoice(str, Enum):
@@ -134,8 +134,7 @@ def app(
         _export_bag(result.run_dir, bag)
     _print_result(result)
     if result.state == "interrupted":
-        err_console.print(f"interrupted; partial results in {result.run_dir}", highlight=False)
-        raise typer.Exit(128 + (result.stop_signal or signal.SIGINT))
+        exit_stopped(result.stop_signal, result.run_dir)
 
 
 def _world_argument(world: str) -> str:

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import signal
 from pathlib import Path
 
 import typer
 
-from seminspect.cli._common import console, err_console, labelled, progress_bar
+from seminspect.cli._common import console, exit_stopped, labelled, progress_bar
 
 app = typer.Typer(no_args_is_help=True, help="Routine inspection on an outdated map (002).")
 
@@ -113,7 +114,7 @@ def inspect_command(
                 shared_prior = run_dir / PRIOR_FILE  # the baseline plans on the same M_H
             if result.state != "completed":
                 break
-    if pictures:
+    if pictures and all(r.stop_signal != signal.SIGTERM for r in results.values()):
         for result in results.values():
             render_routine(result.run_dir)
         if compare and len(results) == len(runs):
@@ -121,9 +122,9 @@ def inspect_command(
             save_figure(figure, out / "comparison.png")
     for name, result in results.items():
         _print_result(name, result)
-    if any(r.state == "interrupted" for r in results.values()):
-        err_console.print(f"interrupted; partial results in {out}", highlight=False)
-        raise typer.Exit(130)
+    stopped = [r for r in results.values() if r.state == "interrupted"]
+    if stopped:
+        exit_stopped(stopped[0].stop_signal, out)
 
 
 def _print_result(name: str, result) -> None:

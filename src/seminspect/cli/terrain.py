@@ -428,7 +428,6 @@ def _map_bag(bag: Path, topics: tuple[str, str, str, str | None], out: Path, enc
 
     from seminspect.mapping.formats.pointfiles import label_names_from_text
     from seminspect.mapping.formats.rosbag import fuse_bag, read_bag_scans, read_label_names
-    from seminspect.mapping.formats.semantickitti import label_table
     from seminspect.mapping.semantic_cloud import save_cloud
 
     cloud_topic, odom_topic, labels_field, names_text = topics
@@ -439,7 +438,7 @@ def _map_bag(bag: Path, topics: tuple[str, str, str, str | None], out: Path, enc
         scans = read_bag_scans(bag, cloud_topic, odom_topic, labels_field)
         cloud = fuse_bag(
             scans,
-            names or label_table().names,
+            names,
             encoder,
             radius,
             on_scan=lambda done: progress.update(task, description=f"fused {done} clouds"),

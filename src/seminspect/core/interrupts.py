@@ -45,8 +45,13 @@ class Interrupted(KeyboardInterrupt):
 
 
 def as_interrupted(exc: KeyboardInterrupt) -> Interrupted:
-    """A plain ``KeyboardInterrupt`` (raised by Python's own handler) is a Ctrl-C."""
-    return exc if isinstance(exc, Interrupted) else Interrupted(signal.SIGINT)
+    """The stop behind ``exc``. A plain ``KeyboardInterrupt`` is the last stop signal that
+    :func:`stop_on_signals` raised (a library such as Ray raises its own ``KeyboardInterrupt``
+    in place of the one it caught), else a Ctrl-C (Python's own handler)."""
+    if isinstance(exc, Interrupted):
+        return exc
+    handler = _Installed.handler
+    return Interrupted(handler.raised if handler and handler.raised else signal.SIGINT)
 
 
 class _Handler:
@@ -55,6 +60,7 @@ class _Handler:
     def __init__(self) -> None:
         self.deferring = 0
         self.pending: int | None = None
+        self.raised: int | None = None  # the last signal raised as Interrupted
 
     def __call__(self, signum: int, frame: FrameType | None) -> None:
         if self.deferring:
@@ -66,6 +72,10 @@ class _Handler:
         if _inside_numba(frame):
             self._raise_on_leaving_numba(signum)
             return
+        self.raise_stop(signum)
+
+    def raise_stop(self, signum: int) -> None:
+        self.raised = signum
         raise Interrupted(signum)
 
     def _raise_on_leaving_numba(self, signum: int) -> None:
@@ -82,7 +92,7 @@ class _Handler:
             if self.deferring:
                 self.pending = self.pending or signum
                 return
-            raise Interrupted(signum)
+            self.raise_stop(signum)
 
         sys.setprofile(on_event)
 
@@ -162,4 +172,4 @@ def deferred_signals() -> Iterator[None]:
         handler.deferring -= 1
         if not handler.deferring and handler.pending is not None:
             signum, handler.pending = handler.pending, None
-            raise Interrupted(signum)
+            handler.raise_stop(signum)

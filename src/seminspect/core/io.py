@@ -2,7 +2,8 @@
 
 Every file seminspect writes goes through :func:`atomic_write_bytes`: the data lands in a
 temporary file in the same directory, is flushed to disk and then renamed over the target, so a
-crash or Ctrl-C leaves either the old file or the new one, never a torn one.
+crash or Ctrl-C leaves either the old file or the new one, never a torn one. An ``OSError`` while
+writing (a full disk) names the target, where the system names the temporary file or no file.
 
 Versioned JSON documents carry a small envelope ``{"format": KIND, "version": N, ...}`` so that a
 reader can refuse a file of another kind or a version it does not understand with a clear message.
@@ -48,17 +49,31 @@ def _temporary_beside(target: Path, suffix: str) -> tuple[int, str]:
         raise OSError(exc.errno, exc.strerror, str(target)) from None
 
 
+@contextlib.contextmanager
+def _naming(target: Path, temporary: str | None = None) -> Iterator[None]:
+    """An ``OSError`` writing ``target`` names it: a failed ``write`` names no file, and the
+    temporary file beside ``target`` means nothing to the user (another file's error stays)."""
+    try:
+        yield
+    except OSError as exc:
+        named = None if exc.filename is None else os.fsdecode(exc.filename)
+        if exc.errno is None or named not in (None, temporary):
+            raise
+        raise OSError(exc.errno, exc.strerror, str(target)) from None
+
+
 def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> Path:
     """Write ``data`` to ``path`` atomically (temporary file + fsync + rename)."""
     target = Path(path)
     fd, tmp_name = _temporary_beside(target, ".tmp")
     try:
-        os.fchmod(fd, _FILE_MODE)
-        with os.fdopen(fd, "wb") as handle:
-            handle.write(data)
-            handle.flush()
-            os.fsync(handle.fileno())
-        Path(tmp_name).replace(target)
+        with _naming(target, tmp_name):
+            os.fchmod(fd, _FILE_MODE)
+            with os.fdopen(fd, "wb") as handle:
+                handle.write(data)
+                handle.flush()
+                os.fsync(handle.fileno())
+            Path(tmp_name).replace(target)
     except BaseException:
         Path(tmp_name).unlink(missing_ok=True)
         raise
@@ -75,12 +90,29 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[Path]:
     os.close(fd)
     tmp = Path(tmp_name)
     try:
-        yield tmp
-        with tmp.open("rb+") as handle:
-            os.fsync(handle.fileno())
-        tmp.replace(target)
+        with _naming(target, tmp_name):
+            yield tmp
+            with tmp.open("rb+") as handle:
+                os.fsync(handle.fileno())
+            tmp.replace(target)
     finally:
         tmp.unlink(missing_ok=True)
+
+
+def rewrite_in_place(path: str | os.PathLike[str], data: bytes) -> Path:
+    """Overwrite the existing file ``path`` with ``data`` in its own blocks, then cut it to size.
+
+    A last resort where :func:`atomic_write_bytes` fails for want of space: no second copy is
+    needed, so new bytes no longer than the old blocks always fit. A crash midway, or bytes that
+    need a block more on a full disk, leave the file torn.
+    """
+    target = Path(path)
+    with _naming(target), target.open("r+b") as handle:
+        handle.write(data)
+        handle.truncate()
+        handle.flush()
+        os.fsync(handle.fileno())
+    return target
 
 
 def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
@@ -125,8 +157,14 @@ def write_versioned_json(
     indent: int | None = None,
 ) -> Path:
     """Atomically write ``payload`` inside a ``{"format", "version"}`` envelope."""
-    document = {"format": kind, "version": version, **payload}
-    return atomic_write_text(path, dumps_json(document, indent=indent) + "\n")
+    return atomic_write_text(path, versioned_json_text(kind, version, payload, indent))
+
+
+def versioned_json_text(
+    kind: str, version: int, payload: dict[str, Any], indent: int | None = None
+) -> str:
+    """The text :func:`write_versioned_json` writes, for a writer of its own."""
+    return dumps_json({"format": kind, "version": version, **payload}, indent=indent) + "\n"
 
 
 def _reject_constant(token: str) -> float:

@@ -399,8 +399,9 @@ def _coarsen_axis(states: NDArray[np.uint8], axis: int, ratio: float, size: int)
     return out
 
 
-def save_map(path: str | os.PathLike[str], voxel_map: VoxelMap) -> Path:
-    """Write a map as a compressed ``.npz`` (atomically)."""
+def save_map(path: str | os.PathLike[str], voxel_map: VoxelMap, **extra: NDArray) -> Path:
+    """Write a map as a compressed ``.npz`` (atomically), with ``extra`` arrays beside it that
+    :func:`load_map` ignores (a program's own records, such as the site a prior was mapped in)."""
     return save_npz_atomic(
         path,
         format=np.array(MAP_FORMAT),
@@ -408,6 +409,7 @@ def save_map(path: str | os.PathLike[str], voxel_map: VoxelMap) -> Path:
         origin=voxel_map.origin,
         resolution=np.array(voxel_map.resolution),
         states=voxel_map.states,
+        **extra,
     )
 
 

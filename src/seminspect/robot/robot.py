@@ -169,7 +169,7 @@ class Robot:
             point = as_point(position, "robot start position")
         self._check_target(point)
         if not self._free(point):
-            raise InvalidInputError(f"robot start {point.round(3).tolist()} is inside an obstacle")
+            raise InvalidInputError(_blocked_start(world, point, mode))
         heading = world.start_yaw if yaw is None else float(yaw)
         self._log = _Log()
         self._record(0.0, point, heading, point.copy(), heading)
@@ -369,3 +369,18 @@ class Robot:
         log.yaw.append(float(yaw))
         log.odometry_position.append(np.asarray(odom, dtype=np.float64).copy())
         log.odometry_yaw.append(float(odom_yaw))
+
+
+def _blocked_start(world: World, point: Vec3, mode: Mode) -> str:
+    """Why a start that is not free is refused: outside the world's bounds (only x-y count for
+    a ground robot, whose height the collision grid ignores) or inside an obstacle."""
+    axes = 2 if mode == "ground" else 3
+    lo, hi = world.bounds[:, :axes]
+    where = f"robot start {point.round(3).tolist()}"
+    if np.any((point[:axes] < lo) | (point[:axes] > hi)):
+        which = "x-y bounds" if axes == 2 else "bounds"
+        return (
+            f"{where} is outside the world {world.name!r}, whose {which} are "
+            f"{lo.round(3).tolist()} to {hi.round(3).tolist()}"
+        )
+    return f"{where} is inside an obstacle"

@@ -2,7 +2,7 @@
 
 :func:`conduct_run` is the one shape every program's run takes: the work, then its outputs
 whatever happened to the work, then the last status, which names what was not written when a
-stop cut the outputs short.
+stop cut the outputs short, and the file that could not be written when the disk is full.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 from seminspect.core.errors import SeminspectError
 from seminspect.core.interrupts import Interrupted, as_interrupted, deferred_signals
-from seminspect.runs.directory import RunDirectory
+from seminspect.runs.directory import RunDirectory, failure_reason
 
 
 @dataclass
@@ -50,16 +50,17 @@ def conduct_run(
         end.stop = as_interrupted(exc)
         end.state, end.reason = "interrupted", end.stop.describe()
     except Exception as exc:
-        end.state, end.reason, end.error = "failed", f"{type(exc).__name__}: {exc}", exc
+        end.state, end.reason, end.error = "failed", failure_reason(run.root, exc), exc
     try:
         run.settle_images()  # those of work that stopped early
         write_outputs(end)
     except KeyboardInterrupt as exc:
         end.stop = end.stop or as_interrupted(exc)
         end.state = "interrupted"
-        end.reason = _cut_short(run, end.reason, end.stop.describe(), expected)
+        stopped = f"{end.stop.describe()} while writing the outputs"
+        end.reason = _cut_short(run, end.reason, stopped, expected)
     except Exception as exc:
-        failure = f"finishing the run failed: {type(exc).__name__}: {exc}"
+        failure = f"finishing the run failed: {failure_reason(run.root, exc)}"
         end.state, end.reason = "failed", _cut_short(run, end.reason, failure, expected)
         end.error = end.error or exc
     with deferred_signals():  # a second signal must not cut the last status short
@@ -76,7 +77,5 @@ def conduct_run(
 def _cut_short(run: RunDirectory, reason: str, why: str, expected: Sequence[str]) -> str:
     """The reason of a run stopped while writing its outputs, naming the ones not written."""
     missing = [name for name in expected if not run.path(name).exists()]
-    note = f"{why} while writing the outputs" + (
-        f"; not written: {', '.join(missing)}" if missing else ""
-    )
+    note = why + (f"; not written: {', '.join(missing)}" if missing else "")
     return f"{reason}; {note}" if reason else note

@@ -4,7 +4,8 @@ Every program (the xFLIE mission, routine inspection, ...) writes the same frame
 
     <run>/
       run.lock          held while a process writes the run; names that process
-      status.json       state (running, completed, interrupted, failed) and why it stopped;
+      status.json       state (running, completed, interrupted, failed) and why it stopped,
+                        and at the end the cached arrays the run used (``core.cache``);
                         while running, the writer's pid, host and a heartbeat
       config.json       the fully resolved configuration and the code that ran it
       metrics.json      the program's figures, under the program's own format tag; written last
@@ -23,11 +24,16 @@ One process at a time writes a run directory: :meth:`RunDirectory.claimed` takes
 (:mod:`seminspect.runs.lock`), clears the files of the run that was there before (refusing a
 directory that holds anything else), records the configuration and keeps a heartbeat in
 ``status.json`` (:mod:`seminspect.runs.status`).
+
+A full disk still gets its last status written: ``status.json`` is rewritten in place when no
+room is left for a second copy, and a run that cannot record even that says so
+(:class:`StatusNotRecordedError`).
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import re
 import shutil
@@ -44,13 +50,16 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from seminspect.core.errors import InvalidInputError
+from seminspect.core.cache import cache_entries_used, reset_cache_entries_used
+from seminspect.core.errors import InvalidInputError, SeminspectError
 from seminspect.core.interrupts import as_interrupted
 from seminspect.core.io import (
     atomic_write_bytes,
     atomic_write_text,
     dumps_json,
     read_versioned_json,
+    rewrite_in_place,
+    versioned_json_text,
     write_versioned_json,
 )
 from seminspect.core.provenance import code_version
@@ -71,6 +80,25 @@ COMMON_FILES = frozenset(
 COMMON_FOLDERS: Mapping[str, re.Pattern[str]] = {"images": re.compile(r".+\.jpg")}
 #: A temporary file of an atomic write that was cut short: ``.<target>.<random>.<suffix>``.
 _LEFTOVER = re.compile(r"\.(?P<target>.+)\.\w+\.\w+")
+#: The errors of a disk (or a quota) with no room left.
+_NO_ROOM = frozenset({errno.ENOSPC, errno.EDQUOT})
+
+
+class StatusNotRecordedError(SeminspectError):
+    """The last status of a run could not be written (a full disk): its ``status.json`` is out
+    of date."""
+
+
+def failure_reason(root: Path, exc: BaseException) -> str:
+    """Why ``exc`` failed the run in ``root``, for its status: a file of the run that could not
+    be written (a full disk) is named, e.g. ``no space left on device, writing graph.json``."""
+    if isinstance(exc, OSError) and exc.filename is not None and exc.strerror:
+        name, run = Path(os.fsdecode(exc.filename)).absolute(), root.absolute()
+        why = exc.strerror[0].lower() + exc.strerror[1:]
+        if name.is_relative_to(run):
+            return f"{why}, writing {name.relative_to(run)}"
+        return f"{why}: {exc.filename}"
+    return f"{type(exc).__name__}: {exc}"
 
 
 @dataclass(frozen=True)
@@ -162,13 +190,18 @@ class RunDirectory:
         self.finished = False
         try:
             clear_previous_run(self.root, self.layout)
-            self.write_config(config)
             self._writer = {
                 "pid": os.getpid(),
                 "host": socket.gethostname(),
                 "started": time.time(),
             }
-            self.write_status("running")
+            try:
+                self.write_config(config)
+                self.write_status("running")
+                reset_cache_entries_used()  # the last status lists the cached arrays the run used
+            except OSError as exc:  # a full disk: say so in the directory, if there is room
+                self._record_stop(heartbeat, "failed", failure_reason(self.root, exc))
+                raise
             beating = threading.Thread(target=self._beat, args=(heartbeat,), daemon=True)
             beating.start()
             try:
@@ -177,7 +210,7 @@ class RunDirectory:
                 self._record_stop(heartbeat, "interrupted", as_interrupted(exc).describe())
                 raise
             except BaseException as exc:
-                self._record_stop(heartbeat, "failed", f"{type(exc).__name__}: {exc}")
+                self._record_stop(heartbeat, "failed", failure_reason(self.root, exc))
                 raise
             finally:
                 heartbeat.set()
@@ -187,7 +220,8 @@ class RunDirectory:
 
     def _beat(self, stop: threading.Event) -> None:
         while not stop.wait(HEARTBEAT_S):
-            with self._status_lock:
+            # a heartbeat lost to a full disk: the last status will say what went wrong
+            with self._status_lock, contextlib.suppress(OSError):
                 if not self.finished:
                     self._write_status_unlocked("running", "")
 
@@ -197,20 +231,50 @@ class RunDirectory:
             self.finish(state, reason)
 
     def finish(self, state: str, reason: str = "") -> None:
-        """The run's last status; a reader trusts it, so every output must already be on disk."""
+        """The run's last status; a reader trusts it, so every output must already be on disk.
+
+        On a full disk the file is rewritten in place; where even that fails,
+        :class:`StatusNotRecordedError` says so and names the directory.
+        """
         with self._status_lock:
             self.finished = True
-            self._write_status_unlocked(state, reason, ended=time.time())
+            try:
+                self._write_status_unlocked(state, reason, **self._last_details())
+            except OSError as exc:
+                if exc.errno not in _NO_ROOM:
+                    raise
+                self._rewrite_last_status(state, reason, exc)
+
+    def _rewrite_last_status(self, state: str, reason: str, full: OSError) -> None:
+        try:
+            text = self._status_text(state, reason, **self._last_details())
+            rewrite_in_place(self.path("status.json"), text.encode("utf-8"))
+        except OSError as exc:
+            ended = f"{state}: {reason}" if reason else state
+            raise StatusNotRecordedError(
+                f"{self.root}: could not record how the run ended ({ended}): "
+                f"{failure_reason(self.root, full)}, which is out of date or missing; "
+                "free some space and run it again"
+            ) from exc
+
+    @staticmethod
+    def _last_details() -> dict[str, Any]:
+        """What the last status adds: when the run ended and the cache entries it used
+        (``core.cache``: a grid read back, stored or rebuilt after damage)."""
+        return {"ended": time.time(), "cache_entries": cache_entries_used()}
 
     def write_status(self, state: str, reason: str = "", **details: Any) -> None:
         with self._status_lock:
             self._write_status_unlocked(state, reason, **details)
 
     def _write_status_unlocked(self, state: str, reason: str, **details: Any) -> None:
+        atomic_write_text(self.path("status.json"), self._status_text(state, reason, **details))
+
+    def _status_text(self, state: str, reason: str, **details: Any) -> str:
         now = time.time()
         writer = {**self._writer, "heartbeat": now} if self._writer else {}
         payload = {"state": state, "reason": reason, "updated": now, **writer, **details}
-        write_versioned_json(self.path("status.json"), STATUS_FORMAT, 1, payload, indent=2)
+        return versioned_json_text(STATUS_FORMAT, 1, payload, indent=2)
 
     def write_config(self, config: dict[str, Any]) -> None:
         """The resolved configuration, with the code and library versions that run it."""

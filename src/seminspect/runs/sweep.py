@@ -6,6 +6,10 @@ directory, typed, and the columns those figures fill. :func:`run_task` never rai
 failed run is one failed row; :func:`run_on_ray` runs the tasks on a local Ray (one worker per
 core) or on a cluster, and :func:`sweep_tables` writes per-run rows and mean / spread per
 group. The xFLIE mission's grid and columns are :mod:`seminspect.missions.xflie.sweep`.
+
+A stop signal (Ctrl-C, SIGTERM) ends a sweep with :class:`SweepInterrupted`, which holds the
+rows of the tasks that finished and an ``interrupted`` row for each of the others, so that the
+caller can write them as a partial table (``sweep_tables(..., stopped=...)``).
 """
 
 from __future__ import annotations
@@ -14,7 +18,9 @@ import csv
 import io
 import logging
 import os
+import signal
 import statistics
+import threading
 import time
 import traceback
 from collections.abc import Callable, Sequence
@@ -23,6 +29,12 @@ from pathlib import Path
 from typing import Any
 
 from seminspect.core.errors import InvalidInputError, SeminspectError
+from seminspect.core.interrupts import (
+    STOP_SIGNALS,
+    Interrupted,
+    as_interrupted,
+    deferred_signals,
+)
 from seminspect.core.io import atomic_write_text, dumps_json
 
 TABLE_FILES = ("sweep.csv", "sweep.json", "sweep.md")
@@ -30,6 +42,10 @@ TABLE_FILES = ("sweep.csv", "sweep.json", "sweep.md")
 Column = tuple[str, str]
 #: What a run's directory says when it is read back: its state and its figures by column.
 Outcome = tuple[str, dict[str, float | None]]
+#: The state of a row whose task a stop signal kept from finishing.
+INTERRUPTED = "interrupted"
+#: How long a stopped sweep lets the runs it cancelled record their stop before Ray ends (s).
+CANCEL_GRACE_S = 10.0
 
 
 @dataclass(frozen=True)
@@ -74,6 +90,31 @@ class SweepProgram:
     columns: tuple[Column, ...]
 
 
+class SweepInterrupted(Interrupted):
+    """A stop signal ended the sweep. ``rows`` holds a row per task, in the tasks' order: the
+    finished ones, and an ``interrupted`` row (with the reason) for each of the others."""
+
+    def __init__(self, signum: int, rows: list[SweepRow]) -> None:
+        super().__init__(signum)
+        self.rows = rows
+
+
+def _interrupted(
+    tasks: Sequence[SweepTask], rows: Sequence[SweepRow | None], exc: KeyboardInterrupt
+) -> SweepInterrupted:
+    """The stop, with an ``interrupted`` row for every task that has no row."""
+    stop = as_interrupted(exc)
+    why = f"not finished: {stop.describe()}"
+    padded = list(rows) + [None] * (len(tasks) - len(rows))
+    return SweepInterrupted(
+        stop.signum,
+        [
+            row or SweepRow(task.name, task.group, task.seed, INTERRUPTED, error=why)
+            for task, row in zip(tasks, padded, strict=True)
+        ],
+    )
+
+
 def run_task(task: SweepTask, program: SweepProgram) -> SweepRow:
     """Run or reuse one task; any failure becomes a ``failed`` row with its error line."""
     start = time.perf_counter()
@@ -101,12 +142,16 @@ def run_locally(
     program: SweepProgram,
     on_row: Callable[[SweepRow], None] | None = None,
 ) -> list[SweepRow]:
-    """The tasks one after another in this process (no Ray), for small sweeps and tests."""
-    rows = []
-    for task in tasks:
-        rows.append(run_task(task, program))
-        if on_row:
-            on_row(rows[-1])
+    """The tasks one after another in this process (no Ray), for small sweeps and tests;
+    a stop signal raises :class:`SweepInterrupted`."""
+    rows: list[SweepRow] = []
+    try:
+        for task in tasks:
+            rows.append(run_task(task, program))
+            if on_row:
+                on_row(rows[-1])
+    except KeyboardInterrupt as exc:
+        raise _interrupted(tasks, rows, exc) from None
     return rows
 
 
@@ -132,7 +177,9 @@ def run_on_ray(
     Without ``address`` a local Ray starts with ``workers`` CPUs (default: every core) and stops
     at the end; with one, the tasks go to that cluster, whose workers need seminspect installed.
     Exclusive tasks (a mission that charges planning wall time to its robot) run one at a
-    time, beside the others but never beside each other (:func:`_schedule`).
+    time, beside the others but never beside each other (:func:`_schedule`). A stop signal
+    cancels the tasks in flight, gives them :data:`CANCEL_GRACE_S` to record their stop, and
+    raises :class:`SweepInterrupted`.
     """
     ray = _ray()
     if workers is not None and workers < 1:
@@ -144,16 +191,34 @@ def run_on_ray(
         }  # fmt: skip
         if address is None:
             options["num_cpus"] = workers or os.cpu_count() or 1
+        handlers = _stop_handlers()
         try:
             ray.init(address=address, **options)
         except (ConnectionError, RuntimeError, ValueError) as exc:
             raise InvalidInputError(f"cannot start or reach Ray ({exc})") from None
+        finally:
+            _restore(handlers)
     try:
         slots = workers or max(1, int(ray.cluster_resources().get("CPU", 1)))
         return _gather(ray, tasks, program, on_row, slots)
     finally:
         if started_here:
             ray.shutdown()
+
+
+def _stop_handlers() -> dict[int, Any]:
+    """The stop signals' handlers now (none outside the main thread, where none can be set)."""
+    if threading.current_thread() is not threading.main_thread():
+        return {}
+    return {signum: signal.getsignal(signum) for signum in STOP_SIGNALS}
+
+
+def _restore(handlers: dict[int, Any]) -> None:
+    """Put back the handlers ``ray.init`` replaced: its SIGTERM handler exits with 1 and its
+    native one prints a stack dump, where a stopped sweep must still write its table."""
+    for signum, handler in handlers.items():
+        if handler is not None:  # None: set outside Python, nothing to put back
+            signal.signal(signum, handler)
 
 
 def _schedule(tasks: Sequence[SweepTask], running: Sequence[int]) -> Callable[[], int | None]:
@@ -182,25 +247,50 @@ def _gather(
     running: list[int] = []
     next_index = _schedule(tasks, running)
     rows: list[SweepRow | None] = [None] * len(tasks)
-    while True:
-        while len(pending) < slots and (index := next_index()) is not None:
-            pending[remote.remote(tasks[index], program)] = index
-            running.append(index)
-        if not pending:
-            break
-        done, _ = ray.wait(list(pending), num_returns=1)
-        index = pending.pop(done[0])
-        running.remove(index)
-        try:
-            row = ray.get(done[0])
-        except Exception as exc:  # the worker itself died (killed, out of memory)
-            task = tasks[index]
-            first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-            row = SweepRow(task.name, task.group, task.seed, "failed", error=first)
-        rows[index] = row
-        if on_row:
-            on_row(row)
+    try:
+        while True:
+            while len(pending) < slots and (index := next_index()) is not None:
+                pending[remote.remote(tasks[index], program)] = index
+                running.append(index)
+            if not pending:
+                break
+            done, _ = ray.wait(list(pending), num_returns=1)
+            index = pending[done[0]]
+            rows[index] = _ray_row(ray, done[0], tasks[index])
+            del pending[done[0]]  # only now: a stop while getting the row must still find it
+            running.remove(index)
+            if on_row:
+                on_row(rows[index])
+    except KeyboardInterrupt as exc:
+        with deferred_signals():  # a second Ctrl-C must not cut the cancellation short
+            _cancel(ray, pending, tasks, rows)
+        raise _interrupted(tasks, rows, exc) from None
     return [row for row in rows if row is not None]
+
+
+def _ray_row(ray, ref, task: SweepTask) -> SweepRow:
+    """The row a finished Ray task returned, or a failed row when its worker died."""
+    try:
+        return ray.get(ref)
+    except Exception as exc:  # the worker itself died (killed, out of memory)
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        return SweepRow(task.name, task.group, task.seed, "failed", error=first)
+
+
+def _cancel(
+    ray, pending: dict[Any, int], tasks: Sequence[SweepTask], rows: list[SweepRow | None]
+) -> None:
+    """Cancel the tasks in flight (Ray raises KeyboardInterrupt in them, so each run records
+    its stop) and keep the rows of those that finish within :data:`CANCEL_GRACE_S`."""
+    for ref in pending:
+        ray.cancel(ref)
+    if not pending:
+        return
+    done, _ = ray.wait(list(pending), num_returns=len(pending), timeout=CANCEL_GRACE_S)
+    for ref in done:
+        row = _ray_row(ray, ref, tasks[pending[ref]])
+        if row.state != "failed":  # a cancelled task reads as a dead worker: it did not finish
+            rows[pending[ref]] = row
 
 
 # --- the table ---------------------------------------------------------------------------------
@@ -218,9 +308,10 @@ class GroupSummary:
 
 
 def summarise(rows: Sequence[SweepRow], columns: Sequence[Column]) -> list[GroupSummary]:
-    """One summary per group (world, scenario, settings) over its seeds, in order of first row."""
+    """One summary per group (world, scenario, settings) over its seeds, in order of first row;
+    rows of tasks a stop kept from running count in no group."""
     groups: dict[str, list[SweepRow]] = {}
-    for row in rows:
+    for row in (r for r in rows if r.state != INTERRUPTED):
         groups.setdefault(row.group, []).append(row)
     summaries = []
     for group, members in groups.items():
@@ -243,11 +334,16 @@ def _cell(value: float | None) -> str:
 
 
 def markdown_tables(
-    rows: Sequence[SweepRow], groups: Sequence[GroupSummary], columns: Sequence[Column]
+    rows: Sequence[SweepRow],
+    groups: Sequence[GroupSummary],
+    columns: Sequence[Column],
+    stopped: str = "",
 ) -> str:
-    """Per-group mean ± standard deviation, then every run, in the program's columns."""
+    """Per-group mean ± standard deviation, then every run, in the program's columns; a sweep
+    ``stopped`` (the reason) is marked partial above both."""
     heads = [f"{c} ({u})" if u else c for c, u in columns]
-    lines = ["## Mean ± standard deviation per group", ""]
+    lines = [partial_note(rows, stopped), ""] if stopped else []
+    lines += ["## Mean ± standard deviation per group", ""]
     lines += ["| group | runs | failed | " + " | ".join(heads) + " |"]
     lines += ["|---" * (3 + len(heads)) + "|"]
     for g in groups:
@@ -268,6 +364,15 @@ def markdown_tables(
     return "\n".join(lines) + "\n"
 
 
+def partial_note(rows: Sequence[SweepRow], stopped: str) -> str:
+    """The line that marks the table of a sweep ``stopped`` (the reason) as partial."""
+    finished = sum(r.state != INTERRUPTED for r in rows)
+    return (
+        f"**Partial table**: the sweep was {stopped}; {finished} of {len(rows)} runs finished, "
+        f"the others are listed as {INTERRUPTED}."
+    )
+
+
 def _csv(rows: Sequence[SweepRow], columns: Sequence[Column]) -> str:
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
@@ -282,19 +387,32 @@ def _csv(rows: Sequence[SweepRow], columns: Sequence[Column]) -> str:
 
 
 def sweep_tables(
-    rows: Sequence[SweepRow], out_dir: str | os.PathLike[str], columns: Sequence[Column]
+    rows: Sequence[SweepRow],
+    out_dir: str | os.PathLike[str],
+    columns: Sequence[Column],
+    stopped: str = "",
 ) -> list[Path]:
-    """Write ``sweep.csv`` (per run), ``sweep.json`` (runs and groups) and ``sweep.md``."""
+    """Write ``sweep.csv`` (per run), ``sweep.json`` (runs and groups) and ``sweep.md``.
+
+    The tables of a sweep ``stopped`` by a signal (the reason) are partial: ``sweep.json``
+    says so (``partial``, ``stopped``), ``sweep.md`` opens with it, and in every table the runs
+    that did not finish have the state ``interrupted``.
+    """
     root = Path(out_dir)
     groups = summarise(rows, columns)
-    document = {
-        "format": "seminspect.sweep",
-        "version": 1,
-        "runs": [asdict(r) for r in rows],
-        "groups": [asdict(g) for g in groups],
-    }
+    document: dict[str, Any] = {"format": "seminspect.sweep", "version": 1}
+    if stopped:
+        document |= {"partial": True, "stopped": stopped}
+    document |= {"runs": [asdict(r) for r in rows], "groups": [asdict(g) for g in groups]}
     return [
         atomic_write_text(root / TABLE_FILES[0], _csv(rows, columns)),
         atomic_write_text(root / TABLE_FILES[1], dumps_json(document, indent=2) + "\n"),
-        atomic_write_text(root / TABLE_FILES[2], markdown_tables(rows, groups, columns)),
+        atomic_write_text(root / TABLE_FILES[2], markdown_tables(rows, groups, columns, stopped)),
     ]
+
+
+def remove_tables(out_dir: str | os.PathLike[str]) -> None:
+    """Delete an earlier sweep's tables, so that none passes for this sweep's while it runs
+    (or after it was killed); each run's own directory keeps its figures."""
+    for name in TABLE_FILES:
+        (Path(out_dir) / name).unlink(missing_ok=True)

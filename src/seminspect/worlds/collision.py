@@ -21,6 +21,10 @@ closer than ``radius`` to a surface; it underestimates by at most ``2*r*sqrt(d)`
 Each grid's distances are kept in the on-disk cache (``core.cache``) under a hash of the mesh,
 the grid's parameters and this module's code: the next mission on the same world reads them
 back instead of spending seconds on the rasterisation and the distance transform.
+
+A world too large for its grids (more than :data:`MAX_GRID_CELLS` cells: a user world loaded at
+the wrong scale) is refused from its extent alone, before anything is allocated
+(:func:`check_grid_sizes`).
 """
 
 from __future__ import annotations
@@ -49,6 +53,13 @@ COLLISION_MODES: tuple[str, ...] = ("ground", "aerial")
 #: about 2 s and 0.5 GB to build (scipy's distance transform keeps indices per cell).
 MAX_SPACE_CELLS = 12_000_000
 SPACE_RESOLUTIONS = (0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5, 0.75, 1.0)
+#: Refuse a grid of more cells than this before allocating it: 17x the largest built-in grid
+#: (the city's 0.05 m ground grid has 6 M cells, every aerial grid at most 12 M), a 0.05 m ground
+#: grid about 700 m across, and 7-10 GB of memory to build (:data:`BUILD_BYTES_PER_CELL`).
+MAX_GRID_CELLS = 200_000_000
+#: Peak memory of building a grid, per cell: the distance transform's indices and float64
+#: distances (measured with scipy 1.17: 33 bytes a cell in 2D, 49 in 3D).
+BUILD_BYTES_PER_CELL = 50
 
 
 @dataclass(frozen=True)
@@ -126,6 +137,32 @@ def _distances(occupied: NDArray[np.bool_], resolution: float) -> NDArray[np.flo
     return distance.astype(np.float32)
 
 
+def check_grid_sizes(
+    bounds: NDArray[np.float64],
+    ground_resolution: float = 0.05,
+    aerial_resolution: float | None = None,
+    fix: str = "use smaller bounds or a coarser grid resolution",
+) -> None:
+    """Refuse ``bounds`` whose ground or aerial grid would exceed :data:`MAX_GRID_CELLS`, from
+    its extent alone, before anything is allocated; ``fix`` ends the message."""
+    box = np.asarray(bounds, dtype=np.float64)
+    extent = box[1] - box[0]
+    size = " x ".join(f"{e:.4g}" for e in extent)
+    if not np.all(np.isfinite(extent)):
+        raise InvalidInputError(f"the world's extent ({size} m) is not finite; {fix}")
+    resolutions = (ground_resolution, aerial_resolution or space_resolution(box))
+    for mode, resolution, axes in zip(COLLISION_MODES, resolutions, (2, 3), strict=True):
+        cells = float(np.prod(np.maximum(np.ceil(extent[:axes] / resolution), 1.0)))
+        if cells > MAX_GRID_CELLS:
+            gigabytes = cells * BUILD_BYTES_PER_CELL / 1e9
+            raise InvalidInputError(
+                f"the world is {size} m: its {mode} collision grid would have {cells:.3g} cells "
+                f"at {resolution:g} m (about {gigabytes:.3g} GB to build), more than the "
+                f"{MAX_GRID_CELLS:.3g} cells seminspect builds (a ground grid about 700 m across); "
+                f"{fix}"
+            )
+
+
 def space_resolution(bounds: NDArray[np.float64], max_cells: int = MAX_SPACE_CELLS) -> float:
     """Finest resolution of :data:`SPACE_RESOLUTIONS` whose grid over ``bounds`` fits."""
     extent = bounds[1] - bounds[0]
@@ -163,6 +200,7 @@ class CollisionField:
     ) -> None:
         if not (0.0 <= band[0] < band[1]):
             raise InvalidInputError(f"ground band must satisfy 0 <= low < high, got {band}")
+        check_grid_sizes(bounds, ground_resolution, aerial_resolution)
         self._triangles = triangles
         self._face_instance = face_instance
         self._is_ground = is_ground

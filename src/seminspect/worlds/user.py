@@ -41,6 +41,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.core.io import atomic_write_bytes, read_json, read_yaml, write_versioned_json
 from seminspect.worlds.builder import WorldBuilder
+from seminspect.worlds.collision import check_grid_sizes
 from seminspect.worlds.shapes import pose_matrix
 from seminspect.worlds.world import BACKGROUND, World
 
@@ -50,6 +51,11 @@ MESH_SUFFIXES = (".obj", ".ply", ".glb", ".gltf", ".stl", ".off")
 LABELS_SUFFIXES = (".json", ".yaml", ".yml")
 #: Refuse meshes above this size before parsing them.
 MAX_MESH_BYTES = 512 << 20
+#: How to shrink a world too large for its collision grids.
+_SIZE_FIX = (
+    "is its scale right? 'scale: {scale:g}' turns mesh units into metres: use a smaller scale "
+    "or tighter 'bounds:'"
+)
 
 
 class _Entry(BaseModel):
@@ -293,6 +299,7 @@ def load_world(mesh_path: str | os.PathLike[str], labels_path: str | os.PathLike
             builder.add_ground(lo[:2] - margin[:2], hi[:2] + margin[:2], float(lo[2]))
             lo, hi = lo - margin, hi + margin
         bounds = np.array(labels.bounds or [lo, hi + np.array([0.0, 0.0, 2.0])])
+        check_grid_sizes(bounds, fix=_SIZE_FIX.format(scale=labels.scale))
         start = labels.start or _Start(position=(bounds[0, 0] + 1.0, bounds[0, 1] + 1.0, lo[2]))
         # the ground is the mesh's lowest point unless the file says otherwise (a saved world)
         metadata = {"ground_z": float(lo[2]), **labels.metadata, "source": str(mesh_path)}

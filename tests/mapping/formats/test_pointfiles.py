@@ -140,7 +140,11 @@ def test_real_lzf_pcd_matches_reference(shared_data) -> None:
         ("c.ply", _ply("ascii").replace(b"element vertex 3", b"element vertex 4"), "rows"),
         ("d.ply", _ply("ascii").replace(b"format ascii", b"format weird"), "format"),
         ("e.pcd", _pcd("binary")[:-5], "truncated"),
-        ("f.pcd", _pcd("ascii").replace(b"POINTS 3", b"POINTS 4"), "expected 4 points"),
+        (
+            "f.pcd",
+            _pcd("ascii").replace(b"POINTS 3", b"POINTS 4").replace(b"WIDTH 3", b"WIDTH 4"),
+            "expected 4 points",
+        ),
         ("g.pcd", _pcd("ascii").replace(b"SIZE 4 4 4 4 4", b"SIZE 4 4 4 4"), "differ"),
         ("h.pcd", _pcd("ascii").replace(b"0.0 1.0 2.0", b"nan 1.0 2.0"), "NaN"),
         ("i.pcd", _pcd("binary_compressed")[:-3], "truncated"),
@@ -171,3 +175,40 @@ def test_label_names_text() -> None:
     assert label_names_from_text("0=grass, 1=car") == {0: "grass", 1: "car"}
     with pytest.raises(InvalidInputError):
         label_names_from_text("grass")
+
+
+def _vertex_ply(encoding: str, declared: int, rows: int) -> bytes:
+    """A vertex-only PLY whose header declares ``declared`` vertices over ``rows`` of data."""
+    header = f"ply\nformat {encoding} 1.0\nelement vertex {declared}\n"
+    header += "property float x\nproperty float y\nproperty float z\nend_header\n"
+    points = np.arange(3 * rows, dtype=np.float32).reshape(rows, 3)
+    if encoding == "ascii":
+        return (header + "".join(f"{x} {y} {z}\n" for x, y, z in points)).encode()
+    return header.encode() + points.astype("<f4" if "little" in encoding else ">f4").tobytes()
+
+
+@pytest.mark.parametrize("encoding", ["ascii", "binary_little_endian", "binary_big_endian"])
+def test_a_ply_hiding_rows_behind_its_header_is_refused(tmp_path, encoding) -> None:
+    path = tmp_path / "cloud.ply"
+    path.write_bytes(_vertex_ply(encoding, 6900, 7000))
+    with pytest.raises(FileFormatError, match=r"cloud\.ply: the header says 6900 vertices"):
+        load_point_file(path)
+    with pytest.raises(FileFormatError, match="7000") as caught:
+        load_point_file(path)
+    assert "\n" not in str(caught.value)
+    path.write_bytes(_vertex_ply(encoding, 7000, 7000) + b"\n")  # a trailing newline is no row
+    assert load_point_file(path).points.shape == (7000, 3)
+
+
+def test_pcd_sizes_that_disagree_are_refused(tmp_path) -> None:
+    path = tmp_path / "cloud.pcd"
+    path.write_bytes(_pcd("ascii").replace(b"WIDTH 3", b"WIDTH 4"))
+    with pytest.raises(FileFormatError, match=r"WIDTH 4 x HEIGHT 1 is 4 points, POINTS says 3"):
+        load_point_file(path)
+    # POINTS 2 over three points of binary data: the third would be dropped
+    hidden = _pcd("binary").replace(b"POINTS 3", b"POINTS 2").replace(b"WIDTH 3", b"WIDTH 2")
+    path.write_bytes(hidden)
+    with pytest.raises(FileFormatError, match=r"cloud\.pcd: POINTS says 2, the data holds 3"):
+        load_point_file(path)
+    path.write_bytes(_pcd("binary") + b"\n")  # padding shorter than a point holds none
+    np.testing.assert_allclose(load_point_file(path).points, POINTS)

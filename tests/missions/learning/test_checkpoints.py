@@ -9,6 +9,7 @@ import pytest
 import torch
 
 from seminspect.core.errors import FileFormatError, SeminspectError
+from seminspect.missions.learning.agent import shipped_policy_path
 from seminspect.missions.learning.checkpoints import load_policy, read_checkpoint, save_checkpoint
 from seminspect.missions.learning.policy import InspectionPolicy, PolicyConfig
 from seminspect.missions.learning.train_config import TrainConfig
@@ -71,3 +72,58 @@ def test_checkpoints_of_other_kinds_or_networks_are_refused(tmp_path: Path) -> N
     broken = PolicyConfig.small().model_dump(mode="json") | {"gru_size": -3}
     with pytest.raises(SeminspectError, match="gru_size"):
         load_policy(forged(tmp_path, policy_config=broken))
+
+
+# Damaged after they were written, or declaring fields of the wrong type: one line naming the
+# file, never other weights or an internal error.
+def test_damaged_weights_are_refused_by_their_crc(tmp_path: Path) -> None:
+    policy = small_policy()
+    path = save_checkpoint(tmp_path / "policy.pt", policy, TrainConfig(), steps=10)
+    weights = max(policy.state_dict().values(), key=lambda t: t.numel())
+    data = bytearray(path.read_bytes())
+    start = data.find(weights.numpy().tobytes())
+    assert start > 0  # the tensor's bytes lie stored, uncompressed, in the archive
+    data[start + 8 : start + 16] = bytes(b ^ 0xFF for b in data[start + 8 : start + 16])
+    path.write_bytes(bytes(data))
+    with pytest.raises(FileFormatError, match="damaged policy checkpoint") as caught:
+        read_checkpoint(path)
+    message = str(caught.value)
+    assert str(path) in message and "CRC" in message and "\n" not in message
+
+
+def test_damaged_shipped_policy_is_refused(tmp_path: Path) -> None:
+    data = bytearray(Path(shipped_policy_path()).read_bytes())
+    data[-len(data) // 3] ^= 0x01  # one bit, deep inside a weight tensor
+    damaged = tmp_path / "policy.pt"
+    damaged.write_bytes(bytes(data))
+    with pytest.raises(FileFormatError, match="fails its CRC check"):
+        read_checkpoint(damaged)
+
+
+@pytest.mark.parametrize(
+    ("changes", "expected"),
+    [
+        ({"steps": "many"}, "invalid field steps: Input should be a valid integer"),
+        ({"steps": True}, "invalid field steps: Input should be a valid integer"),
+        ({"steps": -5}, "invalid field steps: Input should be greater than or equal to 0"),
+        ({"policy_config": "small"}, "invalid field policy_config"),
+        ({"train_config": [1, 2]}, "invalid field train_config"),
+        ({"train_config": TrainConfig().model_dump() | {"seed": True}}, "configuration seed"),
+    ],
+)
+def test_declared_fields_of_the_wrong_type_are_refused(
+    tmp_path: Path, changes: dict[str, object], expected: str
+) -> None:
+    path = forged(tmp_path, **changes)
+    with pytest.raises(FileFormatError, match=expected) as caught:
+        read_checkpoint(path)
+    assert str(caught.value).startswith(f"{path}: ")
+
+
+def test_a_checkpoint_without_steps_still_reads_as_zero_steps(tmp_path: Path) -> None:
+    path = save_checkpoint(tmp_path / "policy.pt", small_policy(), TrainConfig(), steps=10)
+    assert read_checkpoint(path).steps == 10
+    payload = torch.load(path, weights_only=True)
+    del payload["steps"]
+    torch.save(payload, path)
+    assert read_checkpoint(path).steps == 0

@@ -64,3 +64,40 @@ def test_every_scenario_has_default_tasks_a_user_site_none():
     bare = SitePair("user", 0, site.historical, site.current, {"kind": "user"})
     with pytest.raises(InvalidInputError, match="task file"):
         default_tasks(bare)
+
+
+def task_file(tmp_path, vertices, name="face"):
+    path = tmp_path / "tasks.yaml"
+    path.write_text(f"regions:\n  - name: {name}\n    vertices: {vertices}\n")
+    return path
+
+
+def test_a_self_crossing_region_is_refused_with_the_reason(tmp_path):
+    bowtie = [[20.0, 1.3, 0.8], [20.0, 3.7, 2.4], [20.0, 3.7, 0.8], [20.0, 1.3, 2.4]]
+    path = task_file(tmp_path, bowtie, "bowtie")
+    with pytest.raises(FileFormatError) as caught:
+        load_tasks(path)
+    message = str(caught.value)
+    assert message.startswith(f"{path}: region 'bowtie' is not a simple polygon (")
+    assert "Self-intersection" in message and "in order around its outline" in message
+
+
+def test_a_region_away_from_the_site_is_refused_naming_it(tmp_path):
+    site = mine_drift_site("nominal", 0, 20.0)
+    far = np.add(FACE, [0.0, 1000.0, 0.0]).tolist()
+    path = task_file(tmp_path, far, "far-face")
+    assert load_tasks(path)[0].name == "far-face"  # without the site nothing says where it is
+    with pytest.raises(FileFormatError) as caught:
+        load_tasks(path, site)
+    message = str(caught.value)
+    assert message.startswith(f"{path}: region 'far-face' spans x 20.0..20.0 y 1001.3..1003.7")
+    assert "outside the site (x 0.0..21.0 y 0.0..5.0 z 0.0..4.5)" in message
+
+
+@pytest.mark.parametrize("scenario", ["nominal", "receding", "advancing", "obstructed"])
+def test_the_default_regions_lie_on_their_site(tmp_path, scenario):
+    site = mine_drift_site(scenario, 0, 12.0)
+    regions = default_tasks(site)
+    lines = "".join(f"  - name: {r.name}\n    vertices: {r.vertices.tolist()}\n" for r in regions)
+    (tmp_path / "t.yaml").write_text("regions:\n" + lines)
+    assert [r.name for r in load_tasks(tmp_path / "t.yaml", site)] == [r.name for r in regions]

@@ -60,6 +60,10 @@ def test_explicit_settings_win_over_defaults() -> None:
         ({"robots": ["explorer", "pilot"]}, "robots.1: Input should be 'explorer' or"),
         ({"robots": ["inspector", "inspector"]}, "one explorer and one inspector"),
         ({"robots": ["explorer"]}, "one explorer and one inspector, got explorer"),
+        # YAML's true is an int to Python: it would run seed 1, a 1 s budget, a cap of 1 level
+        ({"seed": True}, "seed takes a number, not true/false"),
+        ({"time_budget_s": True}, "time_budget_s takes a number, not true/false"),
+        ({"inspection": {"max_levels": True}}, "inspection: max_levels takes a number"),
     ],
 )
 def test_impossible_settings_give_one_line(values, message) -> None:

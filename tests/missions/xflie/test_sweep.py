@@ -1,7 +1,10 @@
 """Sweeps of missions: the grid expands into validated tasks, finished runs are reused with the
-figures of their typed metrics, failures are rows, and wall-time-charging missions run alone."""
+figures of their typed metrics, failures are rows, and wall-time-charging missions run alone;
+values that pass for others (true for 1, 1.0 for 1) are refused, and a directory a killed run
+left is taken over."""
 
 import shutil
+from pathlib import Path
 
 import pytest
 
@@ -15,6 +18,7 @@ from seminspect.missions.xflie.sweep import (
     load_spec,
     metric_figures,
 )
+from seminspect.runs.lock import LOCK_FILE, RunDirectoryWarning, RunLock
 from seminspect.runs.sweep import run_locally
 
 
@@ -84,3 +88,52 @@ def test_missions_that_charge_wall_time_must_run_alone(tmp_path) -> None:
     )
     assert [t.exclusive for t in free + charged] == [False, False, True]
     assert [t.seed for t in free + charged] == [0, 1, 0]
+
+
+@pytest.mark.parametrize(
+    ("grid", "key"),
+    [
+        ("seeds: [true]\n", "seeds.0"),
+        ("settings:\n  time_budget_s: [30, true]\n", "time_budget_s"),
+        ("settings:\n  map_resolution: [true]\n", "map_resolution"),
+    ],
+)
+def test_a_true_or_false_for_a_number_is_refused_naming_the_file(tmp_path, grid, key) -> None:
+    path = tmp_path / "grid.yaml"
+    path.write_text("worlds: [campus]\n" + grid)
+    with pytest.raises(FileFormatError, match=key) as raised:
+        load_spec(path)
+    assert str(raised.value).startswith(f"{path}: ")
+    path.write_text("worlds: [campus]\nsettings:\n  charge_planning_time: [true, false]\n")
+    assert load_spec(path).settings == {"charge_planning_time": [True, False]}  # a switch
+
+
+def test_values_that_make_one_mission_twice_are_refused(tmp_path) -> None:
+    spec = SweepSpec(worlds=["campus"], settings={"time_budget_s": [1, 1.0]})
+    with pytest.raises(InvalidInputError, match=r"repeats a mission \(campus-.*=1 and .*=1\.0\)"):
+        expand(spec, tmp_path)
+
+
+def test_a_directory_a_killed_run_left_with_its_lock_is_taken_over(tmp_path) -> None:
+    (task,) = expand(SweepSpec(worlds=["subterranean"], settings={"time_budget_s": [5]}), tmp_path)
+    run_dir = Path(task.run_dir)
+    run_dir.mkdir()
+    (run_dir / LOCK_FILE).write_text("999999999 elsewhere\n")  # no process holds it
+    with pytest.warns(RunDirectoryWarning, match="lock of process 999999999"):
+        (row,) = run_locally([task], MISSIONS)
+    assert (row.state, row.error) == ("completed", "")
+    assert not (run_dir / LOCK_FILE).exists()
+
+
+def test_a_run_directory_in_use_is_neither_deleted_nor_run(tmp_path) -> None:
+    (task,) = expand(SweepSpec(worlds=["subterranean"]), tmp_path)
+    run_dir = Path(task.run_dir)
+    run_dir.mkdir()
+    (run_dir / "status.json").write_text('{"state": "running"}')
+    lock = RunLock.acquire(run_dir / LOCK_FILE)  # a live writer: this process
+    try:
+        (row,) = run_locally([task], MISSIONS)
+        assert row.state == "failed" and "in use by another run" in row.error
+        assert (run_dir / "status.json").read_text() == '{"state": "running"}'
+    finally:
+        lock.release()

@@ -182,9 +182,9 @@ def read_ply(path: str | Path) -> PointData:
     if vertex.has_list:
         raise FileFormatError(f"{source}: list properties on vertices are not supported")
     if encoding == "ascii":
-        table = _ply_ascii_vertices(source, body, elements[:position], vertex)
+        table = _ply_ascii_vertices(source, body, elements, position)
     else:
-        table = _ply_binary_vertices(source, body, elements[:position], vertex, encoding)
+        table = _ply_binary_vertices(source, body, elements, position, encoding)
     fields = {name: table[name] for name, _ in vertex.properties}
     embedding_names = sorted(
         (name for name in fields if re.fullmatch(r"emb_\d+", name)), key=lambda n: int(n[4:])
@@ -198,40 +198,59 @@ def read_ply(path: str | Path) -> PointData:
 
 
 def _ply_ascii_vertices(
-    source: Path, body: bytes, before: list[_PlyElement], vertex: _PlyElement
+    source: Path, body: bytes, elements: list[_PlyElement], position: int
 ) -> dict[str, NDArray]:
-    skip = sum(element.count for element in before)
-    rows = body.decode("ascii", errors="replace").splitlines()[skip : skip + vertex.count]
+    vertex = elements[position]
+    skip = sum(element.count for element in elements[:position])
+    rows = body.decode("ascii", errors="replace").splitlines()
+    while rows and not rows[-1].strip():  # a trailing blank line is no row
+        rows.pop()
+    declared = sum(element.count for element in elements)
+    if len(rows) != declared:  # one line per row: more lines are points the header hides
+        raise FileFormatError(
+            f"{source}: the header says {vertex.count} vertices ({declared} rows in all), "
+            f"the file holds {len(rows)} rows"
+        )
+    rows = rows[skip : skip + vertex.count]
     width = len(vertex.properties)
     try:
         values = np.array([row.split() for row in rows], dtype=np.float64)
     except ValueError:
         raise FileFormatError(f"{source}: vertex rows are not {width} numbers each") from None
     if values.shape != (vertex.count, width) and not (vertex.count == 0 and values.size == 0):
-        raise FileFormatError(
-            f"{source}: expected {vertex.count} vertex rows of {width} values, "
-            f"found {len(rows)} rows"
-        )
+        raise FileFormatError(f"{source}: vertex rows are not {width} numbers each")
     values = values.reshape(vertex.count, width)
     return {name: values[:, i] for i, (name, _) in enumerate(vertex.properties)}
 
 
+def _record_size(element: _PlyElement) -> int:
+    return sum(np.dtype(kind).itemsize for _, kind in element.properties)
+
+
 def _ply_binary_vertices(
-    source: Path, body: bytes, before: list[_PlyElement], vertex: _PlyElement, encoding: str
+    source: Path, body: bytes, elements: list[_PlyElement], position: int, encoding: str
 ) -> dict[str, NDArray]:
     order = "<" if encoding == "binary_little_endian" else ">"
-    offset = 0
-    for element in before:
+    vertex = elements[position]
+    for element in elements[:position]:
         if element.has_list:
             raise FileFormatError(
                 f"{source}: element {element.name!r} with list properties precedes the vertices"
             )
-        offset += element.count * sum(np.dtype(kind).itemsize for _, kind in element.properties)
+    offset = sum(element.count * _record_size(element) for element in elements[:position])
     dtype = np.dtype([(name, order + kind) for name, kind in vertex.properties])
     needed = offset + vertex.count * dtype.itemsize
     if len(body) < needed:
         raise FileFormatError(
             f"{source}: truncated: vertex data needs {needed} bytes, the file has {len(body)}"
+        )
+    surplus = len(body) - needed
+    # when the vertices end the body, data for one more is a vertex the header hides (padding
+    # shorter than a vertex, as a trailing newline, holds none)
+    if position == len(elements) - 1 and surplus >= dtype.itemsize > 0:
+        raise FileFormatError(
+            f"{source}: the header says {vertex.count} vertices, the data holds "
+            f"{vertex.count + surplus // dtype.itemsize}"
         )
     table = np.frombuffer(body, dtype=dtype, count=vertex.count, offset=offset)
     return {name: table[name] for name, _ in vertex.properties}
@@ -286,7 +305,23 @@ def _pcd_header(source: Path, lines: list[str]) -> _PcdHeader:
         kinds.append(_PCD_KINDS[(kind, size)])
     if points < 0 or any(count < 1 for count in counts):
         raise FileFormatError(f"{source}: negative POINTS or COUNT below 1")
+    _check_pcd_size(source, entries, points)
     return _PcdHeader(names, kinds, counts, points, data, comments)
+
+
+def _check_pcd_size(source: Path, entries: dict[str, list[str]], points: int) -> None:
+    """PCL requires ``POINTS == WIDTH * HEIGHT``; a file that disagrees lost points or rows."""
+    if "WIDTH" not in entries or "HEIGHT" not in entries:
+        return
+    try:
+        width, height = int(entries["WIDTH"][0]), int(entries["HEIGHT"][0])
+    except (ValueError, IndexError):
+        raise FileFormatError(f"{source}: PCD header has a malformed WIDTH/HEIGHT") from None
+    if width * height != points:
+        raise FileFormatError(
+            f"{source}: WIDTH {width} x HEIGHT {height} is {width * height} points, "
+            f"POINTS says {points}"
+        )
 
 
 def read_pcd(path: str | Path) -> PointData:
@@ -341,6 +376,12 @@ def _pcd_binary(source: Path, header: _PcdHeader, body: bytes) -> dict[str, NDAr
     if len(body) < needed:
         raise FileFormatError(
             f"{source}: truncated: {header.points} points need {needed} bytes, found {len(body)}"
+        )
+    # padding shorter than one point is no point; more is data the header does not count
+    if dtype.itemsize and len(body) - needed >= dtype.itemsize:
+        raise FileFormatError(
+            f"{source}: POINTS says {header.points}, the data holds "
+            f"{len(body) // dtype.itemsize} points"
         )
     table = np.frombuffer(body, dtype=dtype, count=header.points)
     return {name: table[name] for name in header.names}

@@ -9,10 +9,13 @@ mcap) without a ROS installation. What seminspect reads from a bag:
 * a ``nav_msgs/Odometry`` topic: the sensor's pose in the map frame. Each cloud takes the pose
   interpolated at its header stamp (linear in position, slerp in rotation) between the two
   odometry messages around it; a cloud outside the odometry's time span by more than
-  :data:`MAX_POSE_GAP_S` is refused. TF is not read: the cloud's frame must be the odometry's
-  child frame (true of the bags :func:`write_bag` makes);
+  :data:`MAX_POSE_GAP_S` is refused, and so are two different poses at one stamp (a repeated
+  message counts once). A cloud in the odometry's child frame takes its pose, one in the
+  odometry's frame is in the map already, one in another frame needs a ``/tf_static`` chain
+  from the child frame (``/tf`` is not read);
 * optionally a ``std_msgs/String`` topic :data:`LABEL_NAMES_TOPIC` holding a JSON object of
-  label id -> class name, which :func:`write_bag` adds so the bag names its own labels.
+  label id -> class name, which :func:`write_bag` adds so the bag names its own labels; a bag
+  without it is named by SemanticKITTI's label table, with a :class:`BagWarning`.
 
 Fusing the scans into 001's metric-semantic cloud (Sec III-A.3) is
 :func:`seminspect.mapping.ingest.integrate_labelled_scan`, one view per cloud.
@@ -23,6 +26,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import warnings
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -33,7 +37,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation, Slerp
 
-from seminspect.core.errors import FileFormatError, InvalidInputError
+from seminspect.core.errors import FileFormatError, InvalidInputError, SeminspectError
+from seminspect.mapping.formats.semantickitti import label_table
 from seminspect.mapping.ingest import integrate_labelled_scan
 from seminspect.mapping.semantic_cloud import SemanticCloud, as_transform
 from seminspect.perception.encoders import Encoder
@@ -44,9 +49,16 @@ LABEL_NAMES_TOPIC = "/seminspect/label_names"
 CLOUD_TYPE = "sensor_msgs/msg/PointCloud2"
 ODOMETRY_TYPE = "nav_msgs/msg/Odometry"
 STRING_TYPE = "std_msgs/msg/String"
+TF_STATIC_TOPIC = "/tf_static"
 #: sensor_msgs/PointField datatypes as numpy types.
 _FIELD_TYPES = {1: "i1", 2: "u1", 3: "i2", 4: "u2", 5: "i4", 6: "u4", 7: "f4", 8: "f8"}
 _LABEL_FIELD_TYPE = 6  # uint32, as SemanticKITTI stores labels
+#: Odometry messages at one stamp whose poses differ less than this (m, rad) are one message.
+_SAME_POSE = 1e-9
+
+
+class BagWarning(UserWarning):
+    """Something a bag lacks that reading works around (its label names, ...)."""
 
 
 @dataclass(frozen=True)
@@ -83,17 +95,42 @@ def _opened(path: str | os.PathLike[str]) -> Iterator[Any]:
     from rosbags.highlevel import AnyReader  # noqa: PLC0415 - optional dependency
 
     source = Path(path)
-    if not source.exists():
-        raise InvalidInputError(f"{source}: no such bag")
-    reader = AnyReader([source], default_typestore=typestore)
+    _check_bag_path(source)
     try:
+        reader = AnyReader([source], default_typestore=typestore)
         reader.open()
     except Exception as exc:  # rosbags raises its own error type per bag format
         raise FileFormatError(f"{source}: not a readable ROS bag ({exc})") from None
     try:
         yield reader
+    except SeminspectError as exc:  # what went wrong inside names the bag it is in
+        raise type(exc)(f"{source}: {exc}") from None
     finally:
         reader.close()
+
+
+def _check_bag_path(source: Path) -> None:
+    """Refuse a path that cannot be a bag, saying what is missing."""
+    if not source.exists():
+        raise InvalidInputError(f"{source}: no such bag")
+    if not source.is_dir() or (source / "metadata.yaml").exists():
+        return
+    files = sorted(p.name for p in source.iterdir())
+    storage = [name for name in files if name.endswith((".db3", ".mcap"))]
+    hint = f"; give the storage file {storage[0]} itself" if len(storage) == 1 else ""
+    raise FileFormatError(
+        f"{source}: {'an empty directory' if not files else 'no metadata.yaml'}, not a ROS 2 "
+        f"bag (its directory holds metadata.yaml beside .db3 or .mcap files){hint}"
+    )
+
+
+def _messages(reader, connections: list) -> Iterator[Any]:
+    """The decoded messages of ``connections``; none for none (rosbags would read them all)."""
+    for connection, _, raw in reader.messages(connections=connections) if connections else ():
+        try:
+            yield reader.deserialize(raw, connection.msgtype)
+        except Exception as exc:  # rosbags raises its own error type per serialization
+            raise FileFormatError(f"a message on {connection.topic} is damaged ({exc})") from None
 
 
 def _stamp_ns(header) -> int:
@@ -101,19 +138,25 @@ def _stamp_ns(header) -> int:
 
 
 def cloud_arrays(
-    message, labels_field: str | None = None
+    message, labels_field: str | None = None, topic: str = "the cloud topic"
 ) -> tuple[NDArray[np.float64], NDArray[np.int64] | None]:
     """Finite ``x y z`` points ``(N, 3)`` of a ``PointCloud2`` and its labels (lower 16 bits)."""
     fields = {f.name: f for f in message.fields}
     wanted = ["x", "y", "z", *([labels_field] if labels_field else [])]
     missing = [name for name in wanted if name not in fields]
     if missing:
+        fix = "; name its label field with --labels-field" if missing[0] == labels_field else ""
         raise FileFormatError(
-            f"the clouds have no field {missing[0]!r} (fields: {', '.join(fields)})"
+            f"the clouds on {topic} have no field {missing[0]!r} "
+            f"(fields: {', '.join(fields) or 'none'}){fix}"
         )
     for name in wanted:
-        if fields[name].datatype not in _FIELD_TYPES or fields[name].count != 1:
-            raise FileFormatError(f"cloud field {name!r} is not a single number")
+        size = np.dtype(_FIELD_TYPES.get(fields[name].datatype, "V0")).itemsize
+        if not size or fields[name].count != 1 or fields[name].offset + size > message.point_step:
+            raise FileFormatError(
+                f"cloud field {name!r} on {topic} is not one number within its {message.point_step}"
+                "-byte point"
+            )
     order = ">" if message.is_bigendian else "<"
     dtype = np.dtype(
         {
@@ -136,31 +179,49 @@ def cloud_arrays(
     return points[finite], labels
 
 
-def _odometry_track(reader, connections) -> tuple[NDArray[np.int64], NDArray, NDArray]:
-    stamps, positions, rotations = [], [], []
-    for connection, _, raw in reader.messages(connections=connections):
-        message = reader.deserialize(raw, connection.msgtype)
+def _frame(name: str) -> str:
+    return name.lstrip("/")  # ROS 1 tf names may carry a leading slash
+
+
+@dataclass(frozen=True)
+class _Odometry:  # an odometry topic read: its poses of frame child in frame world
+    track: PoseTrack
+    world: str
+    child: str
+
+
+def _read_odometry(reader, topic: str) -> _Odometry:
+    stamps, positions, rotations, frames = [], [], [], set()
+    for message in _messages(reader, _topic_connections(reader, topic, ODOMETRY_TYPE)):
         pose = message.pose.pose
         stamps.append(_stamp_ns(message.header))
         positions.append([pose.position.x, pose.position.y, pose.position.z])
         q = pose.orientation
         rotations.append([q.x, q.y, q.z, q.w])
+        frames.add((_frame(message.header.frame_id), _frame(message.child_frame_id)))
     if not stamps:
-        raise FileFormatError("the odometry topic has no messages")
-    order = np.argsort(stamps, kind="stable")
-    return np.asarray(stamps)[order], np.asarray(positions)[order], np.asarray(rotations)[order]
+        raise FileFormatError(f"the odometry topic {topic} has no messages")
+    if len(frames) > 1:
+        raise FileFormatError(f"the odometry on {topic} mixes frames {sorted(frames)}")
+    track = PoseTrack(np.asarray(stamps), np.asarray(positions), np.asarray(rotations), topic)
+    return _Odometry(track, *frames.pop())
 
 
 class PoseTrack:
-    """Sensor poses interpolated over odometry stamps."""
+    """Sensor poses interpolated over odometry stamps (in any order; repeats counted once)."""
 
-    def __init__(self, stamps: NDArray[np.int64], positions: NDArray, quaternions: NDArray):
+    def __init__(
+        self, stamps: NDArray, positions: NDArray, quaternions: NDArray, topic: str = "odometry"
+    ):
         norms = np.linalg.norm(quaternions, axis=1)
         if not np.all(np.isfinite(positions)) or not np.all(norms > 0.5):
-            raise FileFormatError("the odometry holds NaN poses or non-unit orientations")
-        self.stamps, self.positions = stamps, positions
-        self.rotations = Rotation.from_quat(quaternions / norms[:, None])
-        self.slerp = Slerp(stamps.astype(float), self.rotations) if len(stamps) > 1 else None
+            raise FileFormatError(f"{topic} holds NaN poses or non-unit orientations")
+        order = np.argsort(stamps, kind="stable")
+        stamps, positions = np.asarray(stamps)[order], np.asarray(positions)[order]
+        rotations = Rotation.from_quat(quaternions[order] / norms[order, None])
+        keep = _new_stamps(stamps, positions, rotations, topic)
+        self.stamps, self.positions, self.rotations = stamps[keep], positions[keep], rotations[keep]
+        self.slerp = Slerp(self.stamps.astype(float), self.rotations) if keep.sum() > 1 else None
 
     def at(self, stamp_ns: int) -> NDArray[np.float64]:
         first, last = int(self.stamps[0]), int(self.stamps[-1])
@@ -178,11 +239,26 @@ class PoseTrack:
         return transform
 
 
+def _new_stamps(stamps: NDArray, positions: NDArray, rotations: Rotation, topic: str) -> NDArray:
+    """Which messages to keep: a repeated stamp and pose (recorded twice) counts once."""
+    repeat = np.diff(stamps) == 0
+    moved = np.linalg.norm(np.diff(positions, axis=0), axis=1)
+    turned = (rotations[1:] * rotations[:-1].inv()).magnitude()
+    clash = repeat & ((moved > _SAME_POSE) | (turned > _SAME_POSE))
+    if clash.any():
+        sec, nanosec = divmod(int(stamps[1:][clash][0]), 1_000_000_000)
+        raise FileFormatError(
+            f"{topic} has two different poses at stamp {sec}.{nanosec:09d} s; "
+            "a cloud there has no one pose (re-record the odometry or drop one of them)"
+        )
+    return np.concatenate([[True], ~repeat])
+
+
 def _topic_connections(reader, topic: str, msgtype: str) -> list:
     found = [c for c in reader.connections if c.topic == topic]
     if not found:
-        topics = sorted({c.topic for c in reader.connections})
-        raise InvalidInputError(f"the bag has no topic {topic!r} (topics: {', '.join(topics)})")
+        topics = ", ".join(sorted({c.topic for c in reader.connections})) or "none"
+        raise InvalidInputError(f"the bag has no topic {topic!r} (topics: {topics})")
     if any(c.msgtype != msgtype for c in found):
         raise InvalidInputError(f"topic {topic!r} is {found[0].msgtype}, not {msgtype}")
     return found
@@ -194,30 +270,93 @@ def read_bag_scans(
     odom_topic: str,
     labels_field: str | None = None,
 ) -> Iterator[BagScan]:
-    """Every cloud of ``cloud_topic`` in bag order, posed from ``odom_topic``."""
+    """Every cloud of ``cloud_topic`` in bag order, posed from ``odom_topic`` (and /tf_static)."""
     with _opened(path) as reader:
-        track = PoseTrack(
-            *_odometry_track(reader, _topic_connections(reader, odom_topic, ODOMETRY_TYPE))
-        )
+        odometry = _read_odometry(reader, odom_topic)
         clouds = _topic_connections(reader, cloud_topic, CLOUD_TYPE)
-        for connection, _, raw in reader.messages(connections=clouds):
-            message = reader.deserialize(raw, connection.msgtype)
+        statics = _static_transforms(reader)  # before the clouds: one message stream at a time
+        posers: dict[str, Callable[[int], NDArray[np.float64]]] = {}
+        for message in _messages(reader, clouds):
             stamp = _stamp_ns(message.header)
-            points, labels = cloud_arrays(message, labels_field)
-            yield BagScan(stamp, points, labels, track.at(stamp))
+            frame = _frame(message.header.frame_id)
+            if frame not in posers:
+                posers[frame] = _poser(odometry, statics, frame, (cloud_topic, odom_topic))
+            points, labels = cloud_arrays(message, labels_field, cloud_topic)
+            yield BagScan(stamp, points, labels, posers[frame](stamp))
 
 
-def read_label_names(path: str | os.PathLike[str]) -> dict[int, str] | None:
-    """The label names a bag carries on :data:`LABEL_NAMES_TOPIC`, or ``None``."""
+def _poser(
+    odometry: _Odometry, statics: Mapping, frame: str, topics: tuple[str, str]
+) -> Callable[[int], NDArray[np.float64]]:
+    """``stamp -> T_map_cloud`` for clouds in ``frame``."""
+    if frame == odometry.child:
+        return odometry.track.at
+    if frame == odometry.world:  # already in the map: the odometry would move it twice
+        return lambda _: np.eye(4)
+    offset = _static_chain(statics, odometry.child, frame)
+    if offset is None:
+        raise InvalidInputError(
+            f"the clouds on {topics[0]} are in frame {frame!r}, the odometry on {topics[1]} "
+            f"poses {odometry.child!r} in {odometry.world!r}, and {TF_STATIC_TOPIC} links no "
+            f"chain from {odometry.child!r} to {frame!r}: record {TF_STATIC_TOPIC}, or the "
+            "clouds in the odometry's child frame"
+        )
+    return lambda stamp: odometry.track.at(stamp) @ offset
+
+
+def _static_transforms(reader) -> dict[tuple[str, str], NDArray[np.float64]]:
+    """``(parent, child) -> T_parent_child`` of every transform on :data:`TF_STATIC_TOPIC`."""
+    found = [c for c in reader.connections if c.topic == TF_STATIC_TOPIC]
+    edges = {}
+    for message in _messages(reader, found):
+        for item in message.transforms:
+            t, q = item.transform.translation, item.transform.rotation
+            transform = np.eye(4)
+            transform[:3, :3] = Rotation.from_quat([q.x, q.y, q.z, q.w]).as_matrix()
+            transform[:3, 3] = [t.x, t.y, t.z]
+            edges[(_frame(item.header.frame_id), _frame(item.child_frame_id))] = transform
+    return edges
+
+
+def _static_chain(
+    edges: Mapping[tuple[str, str], NDArray[np.float64]], start: str, goal: str
+) -> NDArray[np.float64] | None:
+    """``T_start_goal`` along static transforms walked either way, or ``None``."""
+    links: dict[str, list[tuple[str, NDArray]]] = {}
+    for (parent, child), transform in edges.items():
+        links.setdefault(parent, []).append((child, transform))
+        links.setdefault(child, []).append((parent, np.linalg.inv(transform)))
+    reached, queue = {start: np.eye(4)}, [start]
+    while queue:
+        frame = queue.pop(0)
+        for neighbour, transform in links.get(frame, []):
+            if neighbour not in reached:
+                reached[neighbour] = reached[frame] @ transform
+                queue.append(neighbour)
+    return reached.get(goal)
+
+
+def read_label_names(path: str | os.PathLike[str]) -> dict[int, str]:
+    """The label names a bag carries on :data:`LABEL_NAMES_TOPIC`, else SemanticKITTI's.
+
+    A bag without the topic (any bag seminspect did not write) gets SemanticKITTI's label table,
+    with a :class:`BagWarning` saying so.
+    """
     with _opened(path) as reader:
         found = [c for c in reader.connections if c.topic == LABEL_NAMES_TOPIC]
-        for connection, _, raw in reader.messages(connections=found):
-            text = reader.deserialize(raw, connection.msgtype).data
+        for message in _messages(reader, found):
+            text: str = getattr(message, "data", "")  # another type on the topic has none
             try:
                 return {int(k): str(v) for k, v in json.loads(text).items()}
-            except (ValueError, AttributeError):
-                raise FileFormatError(f"{path}: {LABEL_NAMES_TOPIC} is not a JSON object") from None
-    return None
+            except (TypeError, ValueError, AttributeError):
+                raise FileFormatError(f"{LABEL_NAMES_TOPIC} is not a JSON object") from None
+    warnings.warn(
+        f"{path}: no {LABEL_NAMES_TOPIC} topic names the labels; using SemanticKITTI's label "
+        "table (give --label-names to name them)",
+        BagWarning,
+        stacklevel=2,
+    )
+    return label_table().names
 
 
 def fuse_bag(

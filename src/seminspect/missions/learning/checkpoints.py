@@ -2,7 +2,9 @@
 
 One file, written atomically by :func:`save_checkpoint`; :func:`read_checkpoint` turns any way
 it can be missing, broken or made for another network into a one-line
-:class:`~seminspect.core.errors.FileFormatError`.
+:class:`~seminspect.core.errors.FileFormatError`. Before unpickling it checks every member's
+CRC (``torch.load`` does not, so damaged weights would load as other numbers) and then the
+types of the fields the file declares.
 """
 
 from __future__ import annotations
@@ -10,10 +12,12 @@ from __future__ import annotations
 import dataclasses
 import pickle
 import zipfile
+import zlib
 from pathlib import Path
+from typing import Any
 
 import torch
-from pydantic import ValidationError
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from seminspect.core.errors import FileFormatError
 from seminspect.core.io import atomic_write_with
@@ -35,6 +39,16 @@ class Checkpoint:
     policy_config: PolicyConfig
     train_config: TrainConfig | None
     steps: int
+
+
+class _Declared(BaseModel):
+    """The payload fields beside the weights, with their types (``steps`` a real int)."""
+
+    model_config = ConfigDict(extra="ignore")
+
+    policy_config: dict[str, Any]
+    train_config: dict[str, Any] | None = None
+    steps: int = Field(0, ge=0, strict=True)  # strict: a bool or "many" is not a step count
 
 
 def save_checkpoint(
@@ -59,11 +73,11 @@ def read_checkpoint(path: str | Path) -> Checkpoint:
     if not source.is_file():
         reason = "is a directory" if source.is_dir() else "no such file"
         raise FileFormatError(f"{source}: {reason}, expected a policy checkpoint")
+    _check_archive(source)
     try:
         payload = torch.load(source, map_location="cpu", weights_only=True)
     except (pickle.UnpicklingError, RuntimeError, EOFError, ValueError, zipfile.BadZipFile) as exc:
-        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise FileFormatError(f"{source}: not a readable policy checkpoint ({first})") from None
+        raise _unreadable(source, exc) from None
     if not isinstance(payload, dict) or payload.get("format") != CHECKPOINT_FORMAT:
         raise FileFormatError(f"{source}: not a {CHECKPOINT_FORMAT} checkpoint")
     if payload.get("version") != CHECKPOINT_VERSION:
@@ -72,8 +86,12 @@ def read_checkpoint(path: str | Path) -> Checkpoint:
             f"(supported: {CHECKPOINT_VERSION})"
         )
     try:
-        policy_config = PolicyConfig.model_validate(payload["policy_config"])
-        train = payload.get("train_config")
+        declared = _Declared.model_validate(payload)
+    except ValidationError as exc:
+        raise FileFormatError(f"{source}: {describe_validation_error(exc, 'field')}") from None
+    try:
+        policy_config = PolicyConfig.model_validate(declared.policy_config)
+        train = declared.train_config
         train_config = None if train is None else TrainConfig.model_validate(train)
     except ValidationError as exc:
         message = describe_validation_error(exc, "configuration")
@@ -86,7 +104,26 @@ def read_checkpoint(path: str | Path) -> Checkpoint:
             f"{source}: its weights do not fit its policy configuration"
         ) from None
     policy.eval()
-    return Checkpoint(policy, policy_config, train_config, int(payload.get("steps", 0)))
+    return Checkpoint(policy, policy_config, train_config, declared.steps)
+
+
+def _check_archive(source: Path) -> None:
+    """Refuse a checkpoint archive with a member whose bytes no longer match their CRC."""
+    try:
+        with zipfile.ZipFile(source) as archive:
+            damaged = archive.testzip()
+    except (zipfile.BadZipFile, zlib.error, EOFError, NotImplementedError) as exc:
+        raise _unreadable(source, exc) from None
+    if damaged is not None:
+        raise FileFormatError(
+            f"{source}: damaged policy checkpoint ({damaged} fails its CRC check); "
+            "copy the file again or train a new one"
+        )
+
+
+def _unreadable(source: Path, exc: Exception) -> FileFormatError:
+    first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    return FileFormatError(f"{source}: not a readable policy checkpoint ({first})")
 
 
 def load_policy(path: str | Path) -> InspectionPolicy:

@@ -12,15 +12,18 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 
 class TrainConfig(BaseModel):
-    """Every hyper-parameter of a training run."""
+    """Every hyper-parameter of a training run (counts strict: a bool or a string is refused,
+    not read as 1 or parsed, e.g. in a checkpoint's recorded settings)."""
 
     model_config = ConfigDict(frozen=True, extra="forbid")
 
-    total_steps: int = Field(2_000_000, gt=0, description="environment steps, all envs together")
-    num_envs: int = Field(64, gt=0)
-    rollout_steps: int = Field(32, gt=0, description="steps per env between updates")
-    epochs: int = Field(4, gt=0)
-    minibatches: int = Field(4, gt=0, description="env-sequence minibatches per epoch")
+    total_steps: int = Field(
+        2_000_000, gt=0, strict=True, description="environment steps, all envs together"
+    )
+    num_envs: int = Field(64, gt=0, strict=True)
+    rollout_steps: int = Field(32, gt=0, strict=True, description="steps per env between updates")
+    epochs: int = Field(4, gt=0, strict=True)
+    minibatches: int = Field(4, gt=0, strict=True, description="env-sequence minibatches per epoch")
     lr: float = Field(3e-4, gt=0)
     anneal_lr: bool = True
     gamma: float = Field(0.99, gt=0, le=1)
@@ -32,9 +35,11 @@ class TrainConfig(BaseModel):
     normalize_rewards: bool = True
     #: (fraction of training, obstacle count) steps; empty: leave the env's own count.
     curriculum: tuple[tuple[float, int], ...] = ((0.0, 0), (0.25, 4), (0.5, 9))
-    checkpoint_every: int = Field(100_000, gt=0, description="environment steps")
-    seed: int = Field(0, ge=0)
-    threads: int = Field(1, gt=0, description="torch threads (the envs share the cores)")
+    checkpoint_every: int = Field(100_000, gt=0, strict=True, description="environment steps")
+    seed: int = Field(0, ge=0, strict=True)
+    threads: int = Field(
+        1, gt=0, strict=True, description="torch threads (the envs share the cores)"
+    )
 
     @model_validator(mode="after")
     def _check(self) -> TrainConfig:

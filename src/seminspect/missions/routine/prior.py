@@ -1,6 +1,13 @@
 """``M_H``, the historical map a routine mission plans on: recorded by a mapping traverse of the
 historical world, or read from a user's file; and the robot and LiDAR that record it and that
-build ``M_C`` during the mission."""
+build ``M_C`` during the mission.
+
+A prior is checked against the site before any work (:func:`check_prior`): a map of another
+place or at another resolution would otherwise plan views on the wrong surfaces and report
+the difference as change. :func:`save_prior` records the world a prior was mapped in (its
+name, the frame of its coordinates, and its bounds) beside the map; priors without those
+fields (other programs' maps, older files) are checked by extent and resolution only.
+"""
 
 from __future__ import annotations
 
@@ -12,18 +19,25 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from seminspect.core.errors import FileFormatError
+from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.geometry.transforms import quat_from_yaw
-from seminspect.mapping.voxel import OCCUPIED, VoxelMap, load_map
+from seminspect.mapping.voxel import OCCUPIED, VoxelMap, load_map, save_map
 from seminspect.missions.routine.config import RoutineConfig
+from seminspect.missions.routine.tasks import describe_box
 from seminspect.robot import Robot
 from seminspect.sensors import Lidar, render
 from seminspect.worlds import World
+from seminspect.worlds.routine_sites import SitePair
 
 #: Free-space clearing distance for LiDAR beams without a return [m].
 CLEAR_MISSES_M = 10.0
 #: Sensing interval while driving [m].
 SENSE_EVERY_M = 1.0
+#: How far each side of a prior's box may lie from the site's bounds [m]: a point-cloud prior
+#: reaches 1 m past its points, and a coarse OctoMap leaf past the surface it holds.
+EXTENT_MARGIN_M = 2.0
+#: The arrays :func:`save_prior` adds to a voxel map file (``load_map`` ignores them).
+SITE_FIELDS = ("site_frame", "site_bounds")
 
 
 LIDAR = Lidar(beams=32, min_elevation_deg=-45.0, max_elevation_deg=45.0,
@@ -74,13 +88,94 @@ def record_prior(
     return prior
 
 
-def load_prior(path: str | os.PathLike[str], resolution: float) -> VoxelMap:
+def save_prior(path: str | os.PathLike[str], prior: VoxelMap, historical: World) -> Path:
+    """Write ``M_H`` as a voxel map file (atomically) that also records the world it was
+    mapped in: ``site_frame`` (the world's name, whose coordinates the map uses) and
+    ``site_bounds``, so that :func:`load_prior` can tell it from a map of another site."""
+    return save_map(
+        path,
+        prior,
+        site_frame=np.array(historical.name),
+        site_bounds=np.asarray(historical.bounds, dtype=np.float64),
+    )
+
+
+def load_prior(
+    path: str | os.PathLike[str], resolution: float, site: SitePair | None = None
+) -> VoxelMap:
     """A historical map from a file: a seminspect map (``.npz``), an OctoMap (``.bt``) or a
-    point cloud (``.ply``/``.pcd``: occupied cells, the rest unknown)."""
-    source = Path(path)
+    point cloud (``.ply``/``.pcd``: occupied cells, the rest unknown). With ``site``, a map
+    that does not fit it is refused (:func:`check_prior`)."""
+    prior, recorded = _read_prior(Path(path), resolution)
+    if site is not None:
+        check_prior(prior, site, resolution, path, recorded)
+    return prior
+
+
+def check_prior(
+    prior: VoxelMap,
+    site: SitePair,
+    resolution: float,
+    source: str | os.PathLike[str],
+    recorded: dict[str, np.ndarray] | None = None,
+) -> None:
+    """Refuse a prior that does not fit the site, in one line naming ``source`` and every
+    difference: another resolution than the mission maps at, another recorded world, or a box
+    whose sides lie more than :data:`EXTENT_MARGIN_M` from the site's bounds."""
+    world = site.historical
+    differences = []
+    if not math.isclose(prior.resolution, resolution, rel_tol=1e-6):
+        differences.append(
+            f"its cells are {prior.resolution:g} m, the mission maps at {resolution:g} m"
+        )
+    frame = None if recorded is None else recorded.get("site_frame")
+    if frame is not None and str(frame) != world.name:
+        differences.append(f"it was mapped in world {str(frame)!r}, the site is {world.name!r}")
+    site_box = np.asarray(world.bounds, dtype=np.float64)
+    prior_box = np.stack([prior.origin, prior.upper])
+    if np.abs(prior_box - site_box).max() > EXTENT_MARGIN_M:
+        differences.append(
+            f"it covers {describe_box(*prior_box)}, the site {describe_box(*site_box)} "
+            f"(sides more than {EXTENT_MARGIN_M:g} m apart)"
+        )
+    if differences:
+        raise InvalidInputError(
+            f"{source}: M_H does not fit the site: {'; '.join(differences)}; record M_H of "
+            "this site with 'seminspect routine map'"
+        )
+
+
+def _read_prior(source: Path, resolution: float) -> tuple[VoxelMap, dict[str, np.ndarray]]:
+    """The map of a prior file and the site fields it records (none but in ``.npz`` files)."""
     suffix = source.suffix.lower()
     if suffix == ".npz":
-        return load_map(source)
+        prior = load_map(source)
+        return prior, _site_fields(source, prior)
+    return _foreign_prior(source, suffix, resolution), {}
+
+
+def _site_fields(source: Path, prior: VoxelMap) -> dict[str, np.ndarray]:
+    """The site fields of a map file, checked against its own grid (a file whose states do not
+    span its recorded bounds was cut or altered: a ``FileFormatError``)."""
+    with np.load(source, allow_pickle=False) as archive:
+        recorded = {key: archive[key] for key in SITE_FIELDS if key in archive.files}
+    if not recorded:
+        return recorded  # not recorded by save_prior
+    frame, bounds = recorded.get("site_frame"), recorded.get("site_bounds")
+    if frame is None or frame.shape != () or frame.dtype.kind != "U":
+        raise FileFormatError(f"{source}: site_frame must be the name of the world mapped")
+    if bounds is None or bounds.shape != (2, 3) or not np.all(np.isfinite(bounds)):
+        raise FileFormatError(f"{source}: site_bounds must be a finite (2, 3) box")
+    expected = tuple(int(n) for n in np.ceil((bounds[1] - prior.origin) / prior.resolution - 1e-9))
+    if prior.shape != expected:
+        raise FileFormatError(
+            f"{source}: voxel states have shape {prior.shape}, its origin, resolution and "
+            f"site bounds need {expected}; record M_H again with 'seminspect routine map'"
+        )
+    return recorded
+
+
+def _foreign_prior(source: Path, suffix: str, resolution: float) -> VoxelMap:
     if suffix == ".bt":
         from seminspect.mapping.formats.octomap import load_octomap  # noqa: PLC0415 - optional extra
 
@@ -89,6 +184,8 @@ def load_prior(path: str | os.PathLike[str], resolution: float) -> VoxelMap:
         from seminspect.mapping.formats.pointfiles import load_point_file  # noqa: PLC0415 - rarely used
 
         points = load_point_file(source).points
+        if not len(points):
+            raise FileFormatError(f"{source}: the point cloud has no points")
         prior = VoxelMap.empty(points.min(axis=0) - 1.0, points.max(axis=0) + 1.0, resolution)
         cells = prior.world_to_index(points)
         prior.states[tuple(cells.T)] = OCCUPIED

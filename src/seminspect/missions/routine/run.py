@@ -40,7 +40,7 @@ from seminspect.missions.routine.metrics import (
     RoutineScenario,
     TaskFigures,
 )
-from seminspect.missions.routine.prior import load_prior, record_prior
+from seminspect.missions.routine.prior import load_prior, record_prior, save_prior
 from seminspect.missions.routine.tasks import default_tasks, load_tasks
 from seminspect.planning.global_views import InspectionRegion
 from seminspect.runs.conduct import RunEnd, conduct_run
@@ -70,6 +70,7 @@ class RoutineResult:
     state: str
     reason: str
     metrics: RoutineMetrics | None  # None when stopped before the mission was built
+    stop_signal: int | None = None  # the signal that interrupted the run, if one did
 
 
 def routine_site(config: RoutineConfig) -> SitePair:
@@ -94,7 +95,7 @@ def map_site(
         run = RunDirectory(out, ROUTINE_LAYOUT)
         with run.claimed({"routine_map": config.model_dump(mode="json")}):
             prior = record_prior(site.historical, config, progress)
-            path = save_map(run.path(MAP_FILE), prior)
+            path = save_prior(run.path(MAP_FILE), prior, site.historical)
             counts = prior.counts()
             run.write_summary(
                 f"# M_H of {config.world} {config.scenario}, seed {config.seed}\n\n"
@@ -121,7 +122,9 @@ def run_routine(
     Ctrl-C or SIGTERM still leave every output gathered so far with a truthful status.
     """
     site = site if site is not None else routine_site(config)
-    regions = load_tasks(tasks_path) if tasks_path is not None else default_tasks(site)
+    regions = load_tasks(tasks_path, site) if tasks_path is not None else default_tasks(site)
+    # a prior that does not fit the site is refused before any run directory is made
+    given = None if prior_path is None else load_prior(prior_path, config.map_resolution, site)
     settings = {
         **config.model_dump(mode="json"),
         "prior": None if prior_path is None else str(prior_path),
@@ -130,9 +133,7 @@ def run_routine(
     with stop_on_signals():
         run = RunDirectory(out, ROUTINE_LAYOUT)
         with run.claimed(settings):
-            return _run_routine(
-                run, config, site, regions, prior_path=prior_path, progress=progress
-            )
+            return _run_routine(run, config, site, regions, prior=given, progress=progress)
 
 
 def _run_routine(
@@ -141,7 +142,7 @@ def _run_routine(
     site: SitePair,
     regions: list[InspectionRegion],
     *,
-    prior_path: str | os.PathLike[str] | None,
+    prior: VoxelMap | None,
     progress: Callable[[str, float], None] | None,
 ) -> RoutineResult:
     started = time.perf_counter()
@@ -150,8 +151,8 @@ def _run_routine(
 
     def work() -> str:
         nonlocal mission
-        prior = _prior(config, site, run, prior_path, progress)
-        mission = RoutineMission(config, site, prior, regions, progress)
+        historical = prior if prior is not None else _record_prior(config, site, run, progress)
+        mission = RoutineMission(config, site, historical, regions, progress)
         return mission.execute()
 
     def write_outputs(end: RunEnd) -> None:
@@ -162,21 +163,19 @@ def _run_routine(
             _write_outputs(run, mission, metrics)
 
     end = conduct_run(run, work, write_outputs, expected=ROUTINE_LAYOUT.outputs, what="routine run")
-    return RoutineResult(run.root, end.state, end.reason, metrics)
+    return RoutineResult(run.root, end.state, end.reason, metrics, end.signum)
 
 
-def _prior(
+def _record_prior(
     config: RoutineConfig,
     site: SitePair,
     run: RunDirectory,
-    prior_path: str | os.PathLike[str] | None,
     progress: Callable[[str, float], None] | None,
 ) -> VoxelMap:
-    if prior_path is not None:
-        return load_prior(prior_path, config.map_resolution)
+    """M_H recorded on the historical site, and saved in the run directory."""
     report = None if progress is None else (lambda share: progress("mapping M_H", share))
     prior = record_prior(site.historical, config, report)
-    save_map(run.path(PRIOR_FILE), prior)
+    save_prior(run.path(PRIOR_FILE), prior, site.historical)
     return prior
 
 

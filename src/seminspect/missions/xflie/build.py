@@ -16,6 +16,7 @@ from seminspect.platform.simulated import SimulatedPlatform, mission_noise
 from seminspect.runs.directory import RunDirectory
 from seminspect.worlds import World, open_world
 from seminspect.worlds.catalog import is_world_path
+from seminspect.worlds.checks import warn_if_no_targets
 
 
 def run_name(config: MissionConfig) -> str:
@@ -42,6 +43,7 @@ def build_mission(
 ) -> tuple[XFlie, World]:
     """The world (made from ``config`` unless given), the robot in it and the executive."""
     world = world or open_world(config.world, config.scenario, seed=config.seed)
+    warn_if_no_targets(world, config.target_classes)
     platform, ground_z = build_platform(config, world)
     occupancy = mission_map(world, config)
     executive = XFlie if inspects(config.planner) else FrontierMission

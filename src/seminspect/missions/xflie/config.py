@@ -7,6 +7,7 @@ form (every default filled in), so a run can be repeated from its ``config.json`
 from __future__ import annotations
 
 import math
+import typing
 from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
@@ -30,6 +31,25 @@ VEHICLE_CLASSES = ("car", "truck")
 
 class _Strict(BaseModel):
     model_config = ConfigDict(frozen=True, extra="forbid")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_bools_for_numbers(cls, data: Any) -> Any:
+        """YAML's true would pass as 1 for a number (a bool is an int to Python): refuse it."""
+        if isinstance(data, dict):
+            for key, value in data.items():
+                if is_bool_for_number(cls, key, value):
+                    raise ValueError(f"{key} takes a number, not true/false")
+        return data
+
+
+def is_bool_for_number(model: type[BaseModel], key: str, value: object) -> bool:
+    """Whether ``value`` is a true/false given for ``model``'s field ``key`` that is no switch."""
+    field = model.model_fields.get(key)
+    if field is None or not isinstance(value, bool):
+        return False
+    annotation = field.annotation
+    return not (annotation is bool or bool in typing.get_args(annotation))
 
 
 class RobotConfig(_Strict):

@@ -24,18 +24,23 @@ from __future__ import annotations
 import itertools
 import math
 import os
-import shutil
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, StrictInt, ValidationError, field_validator
 
 from seminspect.core.errors import FileFormatError, InvalidInputError
-from seminspect.core.io import read_yaml
+from seminspect.core.interrupts import Interrupted
+from seminspect.core.io import dumps_json, read_yaml
 from seminspect.core.validation import describe_validation_error
 from seminspect.missions.xflie.build import run_name
-from seminspect.missions.xflie.config import MissionConfig, make_config, resolve
+from seminspect.missions.xflie.config import (
+    MissionConfig,
+    is_bool_for_number,
+    make_config,
+    resolve,
+)
 from seminspect.missions.xflie.layout import read_run_metrics, reusable_mission
 from seminspect.missions.xflie.metrics import MissionMetrics
 from seminspect.missions.xflie.run import run_mission
@@ -52,8 +57,18 @@ class SweepSpec(BaseModel):
 
     worlds: list[str] = Field(min_length=1)
     scenarios: list[str | None] = Field(default_factory=lambda: [_DEFAULT_SCENARIO], min_length=1)
-    seeds: list[int] = Field(default_factory=lambda: [0], min_length=1)
+    # strict: YAML's true would pass as seed 1 (a bool is an int to Python)
+    seeds: list[StrictInt] = Field(default_factory=lambda: [0], min_length=1)
     settings: dict[str, list[Any]] = Field(default_factory=dict)
+
+    @field_validator("settings")
+    @classmethod
+    def _no_bools_for_numbers(cls, settings: dict[str, list[Any]]) -> dict[str, list[Any]]:
+        """A true/false for a setting that is not a switch would pass as 1 or 0."""
+        for key, values in settings.items():
+            if any(is_bool_for_number(MissionConfig, key, value) for value in values):
+                raise ValueError(f"{key} takes no true/false, got {dumps_json(values)}")
+        return settings
 
 
 def load_spec(path: str | os.PathLike[str]) -> SweepSpec:
@@ -82,6 +97,7 @@ def expand(spec: SweepSpec, out_dir: str | os.PathLike[str]) -> list[SweepTask]:
         if not spec.settings[key]:
             raise InvalidInputError(f"sweep setting {key!r} has no values")
     tasks = []
+    seen: dict[str, str] = {}  # a resolved configuration, as JSON -> the first task's name
     for world, scenario, values in itertools.product(
         spec.worlds, spec.scenarios, itertools.product(*(spec.settings[k] for k in keys))
     ):
@@ -95,13 +111,24 @@ def expand(spec: SweepSpec, out_dir: str | os.PathLike[str]) -> list[SweepTask]:
             group = f"{config.world} {config.scenario or ''}".strip()
             group += "".join(f" {k}={v}" for k, v in chosen.items())
             dumped = config.model_dump(mode="json")
+            _refuse_repeat(seen, dumped, name)
             # A robot that waits for its planners' wall time moves with the machine's load.
             alone = config.charge_planning_time
             tasks.append(SweepTask(name, group, dumped, str(root / name), config.seed, alone))
-    names = [t.name for t in tasks]
-    if len(set(names)) != len(names):
-        raise InvalidInputError("the grid repeats a mission (a world, scenario or seed twice)")
     return tasks
+
+
+def _refuse_repeat(seen: dict[str, str], config: dict[str, Any], name: str) -> None:
+    """Refuse a second task of one resolved configuration (``1`` and ``1.0``, a seed twice):
+    it would fly the same mission twice and count it twice in its group's spread."""
+    key = dumps_json(config)
+    if key in seen:
+        same = name if seen[key] == name else f"{seen[key]} and {name}"
+        raise InvalidInputError(
+            f"the grid repeats a mission ({same}): a world, scenario, seed or setting value "
+            "is given twice; give each once"
+        )
+    seen[key] = name
 
 
 def run_or_reuse(
@@ -109,17 +136,20 @@ def run_or_reuse(
 ) -> bool:
     """Make ``out`` hold a completed run of ``config``; ``True`` when an existing run was reused.
 
-    A directory that is not a run is never deleted; an interrupted, failed or differently
-    configured run is replaced.
+    An interrupted, failed or differently configured run is replaced, and a directory a killed
+    run left (only its stale ``run.lock``, ...) is taken over, as ``seminspect mission --out``
+    does (:meth:`~seminspect.runs.directory.RunDirectory.claimed`); a directory holding
+    anything a run does not write is never deleted. A mission stopped by a signal raises
+    :class:`~seminspect.core.interrupts.Interrupted`: the sweep stops with it.
     """
     config = resolve(config)
     if reusable_mission(out, config):
         return True
-    if out.exists():
-        if not (out / "status.json").is_file():
-            raise InvalidInputError(f"{out} exists and is not a run directory; move it away")
-        shutil.rmtree(out)
-    run_mission(config, out, progress=progress)
+    if out.exists() and not out.is_dir():
+        raise InvalidInputError(f"{out} exists and is not a run directory; move it away")
+    result = run_mission(config, out, progress=progress)
+    if result.stop_signal is not None:
+        raise Interrupted(result.stop_signal)
     return False
 
 

@@ -45,6 +45,7 @@ from seminspect.planning.routes import warm_up
 from seminspect.runs.conduct import RunEnd, conduct_run
 from seminspect.runs.directory import RunDirectory
 from seminspect.worlds import World
+from seminspect.worlds.checks import warn_if_no_targets
 
 
 @dataclass(frozen=True)
@@ -82,6 +83,7 @@ def build_team(
     frontiers the explorer would otherwise visit)."""
     graph: LayeredSemanticGraph | None = None
     missions: dict[str, XFlie] = {}
+    warn_if_no_targets(world, config.target_classes)
     shared_map = mission_map(world, config)
     for role in ("explorer", "inspector"):
         platform, ground_z = build_platform(config, world, name=role)
