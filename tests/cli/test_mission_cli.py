@@ -13,6 +13,7 @@ def test_mission_runs_and_says_where_the_results_are(capsys, tmp_path: Path) -> 
     )
     assert code == 0
     assert "completed" in text and str(out) in text and "query 'Visit car-0': reached" in text
+    assert f"results: {out}  (report.html, summary.md, graph.json, 3 pictures (*.png))" in text
     for picture in ("trajectory.png", "graph.png", "utility.png"):
         assert (out / picture).read_bytes()[:4] == b"\x89PNG"
     assert "plotly" in (out / "report.html").read_text(encoding="utf-8")
@@ -26,6 +27,8 @@ def test_the_frontier_explorer_runs_from_the_command_line(capsys, tmp_path: Path
         "--budget", "60", "--no-pictures", "--out", str(out),
     )  # fmt: skip
     assert code == 0 and "completed" in text and "inspected 0%" in text
+    # the results line names only what was written: --no-pictures draws neither PNG nor page
+    assert f"results: {out}  (summary.md, graph.json, no pictures)" in text
     assert '"planner": "frontier"' in (out / "config.json").read_text(encoding="utf-8")
 
 

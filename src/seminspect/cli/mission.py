@@ -248,10 +248,23 @@ def _print_result(result) -> None:
     for answer in result.answers:
         outcome = "reached" if answer.reached else f"not reached ({answer.error or 'too far'})"
         console.print(f"query '{answer.query}': {outcome}")
-    console.print(f"results: {result.run_dir}  (report.html, summary.md, graph.json, *.png)")
-    console.print(
-        f"query the graph: seminspect graph query {result.run_dir / 'graph.json'} 'Visit ...'"
-    )
+    # unwrapped: paths are copied from these lines
+    outputs = ", ".join(_outputs(result.run_dir))
+    console.print(f"results: {result.run_dir}  ({outputs})", soft_wrap=True)
+    if (result.run_dir / "graph.json").exists():
+        graph = result.run_dir / "graph.json"
+        console.print(
+            f"query the graph: seminspect graph query {graph} 'Visit ...'", soft_wrap=True
+        )
+
+
+def _outputs(run_dir: Path) -> list[str]:
+    """The run's main outputs that exist, so the results line promises nothing absent."""
+    named = [
+        name for name in ("report.html", "summary.md", "graph.json") if (run_dir / name).exists()
+    ]
+    pictures = len(list(run_dir.glob("*.png")))
+    return named + ([f"{pictures} pictures (*.png)"] if pictures else ["no pictures"])
 
 
 def _m(value: float | None) -> str:
