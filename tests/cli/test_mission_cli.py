@@ -1,3 +1,4 @@
+import json
 from pathlib import Path
 
 import pytest
@@ -76,3 +77,26 @@ def test_an_existing_bag_is_refused_before_the_mission(capsys, tmp_path) -> None
     )
     assert code == 1 and "exists; choose a new bag name" in err
     assert not (tmp_path / "run").exists()
+
+
+def test_features_choose_the_parts_recorded_and_the_rest_are_named(capsys, tmp_path) -> None:
+    from seminspect.worlds import WorldBuilder, save_world
+    from seminspect.worlds.shapes import box
+
+    builder = WorldBuilder("odd")
+    builder.add_ground((-5.0, -5.0), (5.0, 5.0))
+    parts = ("body", "mirror", "windows")
+    builder.add_object([box((i, 0, 0), (i + 1, 1, 1), p) for i, p in enumerate(parts)], "car")
+    save_world(
+        builder.build([(-5.0, -5.0, 0.0), (5.0, 5.0, 3.0)], (-4.0, 0.0, 0.0)), tmp_path / "w"
+    )
+    code, _, err = run(
+        capsys, "mission", "--world", str(tmp_path / "w"), "--features", "windows",
+        "--budget", "30", "--no-pictures", "--out", str(tmp_path / "run"),
+    )  # fmt: skip
+    assert code == 0, err
+    assert "ignored: mirror; add them to 'seminspect mission --features'" in err
+    config = json.loads((tmp_path / "run" / "config.json").read_text(encoding="utf-8"))
+    assert config["config"]["feature_labels"] == ["windows"]
+    code, _, err = run(capsys, "mission", "--features", "a/b", "--out", str(tmp_path / "bad"))
+    assert code != 0 and "invalid semantic label 'a/b'" in err and "Traceback" not in err

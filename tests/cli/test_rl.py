@@ -6,7 +6,7 @@ from cli_runner import run
 from seminspect.missions.learning.evaluation import EvaluationResult
 
 
-def test_eval_writes_the_json_the_pictures_and_a_table_beside_table_1(capsys, tmp_path):
+def test_eval_writes_the_json_the_pictures_the_report_and_a_table_beside_table_1(capsys, tmp_path):
     out = tmp_path / "eval"
     code, stdout, err = run(
         capsys, "rl", "eval", "--policy", "orbit", "--obstacles", "0,4", "--episodes", "1",
@@ -19,6 +19,12 @@ def test_eval_writes_the_json_the_pictures_and_a_table_beside_table_1(capsys, tm
     assert (out / "coverage.png").exists() and (out / "episode_04_3d.png").exists()
     assert "92.1" in stdout and "82.6" in stdout  # 004 Table I beside ours
     assert f"{result.at(0).coverage_pct:.1f}" in stdout
+    page = (out / "report.html").read_text(encoding="utf-8")
+    assert "plotly" in page and "004 Table I" in page
+    pictures = len(list(out.glob("*.png")))
+    assert pictures == 7  # coverage.png and three per obstacle count
+    line = f"results: {out}  (report.html, evaluation.json, {pictures} pictures (*.png))"
+    assert line in stdout  # on one line, naming only what exists
 
 
 def test_show_draws_one_episode(capsys, tmp_path):

@@ -25,6 +25,8 @@ def test_map_then_inspect_with_the_recorded_prior(capsys, tmp_path):
     assert status["state"] == "completed"
     assert (tmp_path / "run" / "performance.png").exists()
     assert (tmp_path / "run" / "changes.png").exists()
+    assert (tmp_path / "run" / "report.html").is_file()
+    assert "(report.html, summary.md, metrics.json, 2 pictures (*.png))" in out.replace("\n", "")
 
 
 @pytest.mark.parametrize(
@@ -59,6 +61,7 @@ def test_a_user_site_from_two_exported_worlds(capsys, tmp_path):
     )  # fmt: skip
     assert code == 0, err
     assert "tasks 1/1" in out
+    assert not (tmp_path / "run" / "report.html").exists() and "no pictures" in out
     code, _, err = run(
         capsys, "routine", "inspect", "--historical", str(tmp_path / "before"),
         "--out", str(tmp_path / "x"),
@@ -69,3 +72,54 @@ def test_a_user_site_from_two_exported_worlds(capsys, tmp_path):
         "--current", str(tmp_path / "after"), "--out", str(tmp_path / "y"),
     )  # fmt: skip
     assert code == 1 and "task file" in err
+
+
+def _room_bt(path, size=(30, 20, 15), resolution=0.2):
+    """A closed 6 x 4 x 3 m room as an OctoMap: shell occupied, inside free."""
+    import numpy as np
+
+    pyoctomap = pytest.importorskip("pyoctomap")
+    tree = pyoctomap.OcTree(resolution)
+    for cell in np.ndindex(*size):
+        shell = any(c in (0, n - 1) for c, n in zip(cell, size, strict=True))
+        tree.updateNode((np.array(cell) + 0.5) * resolution, bool(shell))
+    assert tree.writeBinary(str(path))
+    return path
+
+
+def test_an_octomap_is_the_site_with_world_and_refused_as_the_drifts_prior(capsys, tmp_path):
+    bt = _room_bt(tmp_path / "room.bt")
+    tasks = tmp_path / "tasks.yaml"
+    region = [[5.8, 1.2, 0.8], [5.8, 2.8, 0.8], [5.8, 2.8, 2.0], [5.8, 1.2, 2.0]]
+    tasks.write_text(f"regions:\n  - name: east\n    vertices: {region}\n")
+    code, out, err = run(
+        capsys, "routine", "inspect", "--world", str(bt), "--tasks", str(tasks),
+        "--out", str(tmp_path / "run"),
+    )  # fmt: skip
+    assert code == 0, err
+    assert "tasks 1/1" in out and "collisions 0" in out
+    assert (tmp_path / "run" / "prior" / "map.npz").exists()
+    assert (tmp_path / "run" / "changes.png").exists()  # drawn from the prior as painted
+    code, _, err = run(
+        capsys, "routine", "inspect", "--world", str(bt), "--out", str(tmp_path / "x")
+    )  # fmt: skip
+    assert code == 1 and "no default tasks" in err and "--tasks" in err
+    code, _, err = run(
+        capsys, "routine", "inspect", "--prior", str(bt), "--out", str(tmp_path / "y")
+    )  # fmt: skip
+    assert code == 1 and "M_H does not fit the site" in err
+    assert f"--world {bt}" in err.replace("\n", "")  # the way to use the map's own site
+
+
+def test_the_results_line_names_no_pictures_that_were_not_drawn(capsys, tmp_path):
+    bt = _room_bt(tmp_path / "room.bt")
+    tasks = tmp_path / "tasks.yaml"
+    region = [[5.8, 1.2, 0.8], [5.8, 2.8, 0.8], [5.8, 2.8, 2.0], [5.8, 1.2, 2.0]]
+    tasks.write_text(f"regions:\n  - name: east\n    vertices: {region}\n")
+    code, out, err = run(
+        capsys, "routine", "inspect", "--world", str(bt), "--tasks", str(tasks),
+        "--no-pictures", "--out", str(tmp_path / "run"),
+    )  # fmt: skip
+    assert code == 0, err
+    line = next(line for line in out.splitlines() if "results: " in line)
+    assert "summary.md, metrics.json" in line and "no pictures" in line and "*.png" not in line

@@ -1,6 +1,7 @@
 import pytest
 
 from seminspect.core.errors import InvalidInputError, PlanningError, UnknownNameError
+from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.synthetic import synthetic_graph
 from seminspect.perception.observation import Observation
 from seminspect.planning.query import Query, Verb, normalise_name, parse_query, resolve_query
@@ -100,3 +101,27 @@ def test_ambiguous_and_uninspected_names(graph) -> None:
         resolve_query(graph, parse_query(f"Visit {shared} of {first.id}"))
     with pytest.raises(PlanningError, match="not been inspected"):
         resolve_query(graph, parse_query("Visit hood-1 of truck-3"))
+
+
+def test_a_sites_own_part_names_resolve() -> None:
+    """Feature names come from the world's parts (any valid label, not only the built-in
+    vocabulary): spaces, underscores and capitals are written as the graph names them."""
+    graph = LayeredSemanticGraph()
+    graph.register_target(Observation([0, 0, 0.7], label="car", score=1, mask_area=1))
+    graph.optimise_targets()
+    (car,) = graph.targets()
+    graph.begin_inspection(car.id, Observation.view_pose([-3, 0, 0.7]))
+    graph.register_pose(Observation.view_pose([-3, 1, 0.7]))
+    for label, offset in (("Rear Window", 0.0), ("seat_belt", 0.5), ("interior", 1.0)):
+        graph.register_feature(
+            Observation([-1, offset, 1.0], label=label, score=0.9, mask_area=900)
+        )
+    graph.finish_inspection()
+    names = {f.name: f.id for p in graph.target(car.id).levels[0].poses for f in p.features}
+    assert set(names) == {"rear-window-1", "seat_belt-1", "interior-1"}
+    for text, name in (
+        (f"Visit rear window 1 in Level-0 of {car.id}", "rear-window-1"),
+        (f"Observe Seat_Belt-1 of {car.id}", "seat_belt-1"),
+        (f"Visit interior-1 of {car.id}", "interior-1"),
+    ):
+        assert resolve_query(graph, parse_query(text)) == names[name]

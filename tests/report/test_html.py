@@ -3,6 +3,7 @@ real (headless) browser when one is installed."""
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 from collections import Counter
@@ -10,14 +11,14 @@ from pathlib import Path
 
 import pytest
 
-from seminspect.core.errors import InvalidInputError
+from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.graphs.lsg.io import load_graph
 from seminspect.graphs.terrain.io import save_terrain_graph
 from seminspect.graphs.terrain.prompting import TaskPrompts
 from seminspect.graphs.terrain.scene_graph import build_terrain_graph
 from seminspect.mapping.formats.pointfiles import PointData
 from seminspect.mapping.ingest import cloud_from_point_data
-from seminspect.report.html import REPORT_FILE, THUMBNAIL_WIDTH, write_report
+from seminspect.report.html import REPORT_FILE, THUMBNAIL_WIDTH, run_kind, write_report
 
 CHROMIUM_ARGS = [
     "--headless",
@@ -66,7 +67,8 @@ def _figure_layers(page: str) -> dict[str, int]:
     """Layer name -> node count, read from the traces' ``meta`` in the page's figure JSON."""
     import re
 
-    return {m[0]: int(m[1]) for m in re.findall(r'"meta":\{"layer":"(\w+)","nodes":(\d+)\}', page)}
+    found = re.findall(r'"meta":\{"layer":"([^"]+)","nodes":(\d+)\}', page)
+    return {name: int(count) for name, count in found}
 
 
 def _external_sources(page: str) -> list[str]:
@@ -99,6 +101,9 @@ def test_mission_report_has_every_layer_and_the_graph_images(
     assert mission_report.stat().st_size < 4_000_000 + 60_000 * len(images)
     for title in ("000 Table 3", "000 Table 6", "Target selection over time"):
         assert title in page
+    metrics = json.loads((small_mission_dir / "metrics.json").read_text())
+    for match in metrics["targets"]["matches"]:  # each graph target beside the site's own name
+        assert f"<td>{match['target_id']}</td><td>{match['truth']}</td>" in page
 
 
 def test_thumbnails_are_small(mission_report: Path) -> None:
@@ -139,8 +144,21 @@ def test_an_interrupted_run_without_metrics_or_path_still_gets_a_page(
     assert _figure_layers(page) == _expected_mission_layers(small_mission_dir)
 
 
-def test_a_directory_without_a_graph_is_refused(tmp_path: Path) -> None:
-    with pytest.raises(InvalidInputError, match=r"no graph\.json"):
+def test_a_directory_that_is_no_run_is_refused_naming_what_was_looked_for(tmp_path: Path) -> None:
+    (tmp_path / "notes").mkdir()  # a subdirectory that is no routine run either
+    with pytest.raises(InvalidInputError, match=r"no graph\.json") as refused:
+        write_report(tmp_path)
+    message = str(refused.value)
+    assert "\n" not in message and str(tmp_path) in message
+    for looked_for in ("metrics.json", "tour.json", "routine map", "evaluation.json"):
+        assert looked_for in message
+    with pytest.raises(InvalidInputError, match="is not a directory"):
+        write_report(tmp_path / "absent")
+
+
+def test_a_graph_of_another_kind_is_named_with_its_format(tmp_path: Path) -> None:
+    (tmp_path / "graph.json").write_text('{"format": "someone.else", "nodes": []}')
+    with pytest.raises(FileFormatError, match=r"graph\.json: neither a 3DLSG.*'someone\.else'"):
         write_report(tmp_path)
 
 
@@ -155,8 +173,11 @@ _HOVER_FIRST_IMAGE = """() => {
 }"""
 
 
-def _open_in_browser(report: Path, screenshot: Path) -> tuple[list[dict], str | None, list[str]]:
-    """Layer traces as the page's plotly sees them, the hover panel, every console error."""
+def _open_in_browser(
+    report: Path, screenshot: Path, figure: str = "scene", hover: bool = True
+) -> tuple[list[dict], str | None, list[str]]:
+    """Layer traces of ``figure-<figure>`` as the page's plotly sees them, the hover panel
+    after hovering a node with an image (``hover``), every console error."""
     chromium = _chromium()
     if chromium is None:
         pytest.skip("no Chromium found (apt-get install chromium, or set $SEMINSPECT_CHROMIUM)")
@@ -169,20 +190,24 @@ def _open_in_browser(report: Path, screenshot: Path) -> tuple[list[dict], str | 
             page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
             page.on("pageerror", lambda exc: errors.append(str(exc)))
             page.goto(report.as_uri())
+            # a 3D figure has its scene laid out, a 2D one its x axis
             page.wait_for_function(
-                "document.getElementById('figure-scene')?._fullLayout?.scene !== undefined",
+                "id => (l => l?.scene !== undefined || l?.xaxis !== undefined)"
+                "(document.getElementById(id)?._fullLayout)",
+                arg=f"figure-{figure}",
                 timeout=60_000,
             )
             # gd.data keeps the figure's (binary) input; _fullData has what plotly drew
             traces = page.evaluate(
-                "(gd => gd.data.map((t, i) => ({meta: t.meta ?? null, "
-                "points: gd._fullData[i]._length})))(document.getElementById('figure-scene'))"
+                "id => (gd => gd.data.map((t, i) => ({meta: t.meta ?? null, "
+                "points: gd._fullData[i]._length})))(document.getElementById(id))",
+                f"figure-{figure}",
             )
-            hover = page.evaluate(_HOVER_FIRST_IMAGE)
+            panel = page.evaluate(_HOVER_FIRST_IMAGE) if hover else None
             page.screenshot(path=str(screenshot))
         finally:
             browser.close()
-    return traces, hover, errors
+    return traces, panel, errors
 
 
 @pytest.mark.slow
@@ -208,4 +233,154 @@ def test_terrain_report_renders_in_a_browser(terrain_report: Path, tmp_path: Pat
     assert errors == []
     layers = _by_layer(traces)
     assert set(layers) == {"Points", "Objects", "Places", "Regions", "Map"}
+    assert all(t["points"] == t["meta"]["nodes"] for t in layers.values())
+
+
+# --- routine runs and rl evaluations -----------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def routine_run(tmp_path_factory) -> Path:
+    """A short routine run (the advancing face: M_H differs from M_C) with its pictures."""
+    from seminspect.missions.routine.config import RoutineConfig
+    from seminspect.missions.routine.run import run_routine
+    from seminspect.report.routine import render_routine
+
+    out = tmp_path_factory.mktemp("routine") / "run"
+    run_routine(RoutineConfig(scenario="advancing", seed=0, length=12.0), out)
+    render_routine(out)
+    return out
+
+
+@pytest.fixture(scope="module")
+def routine_report(routine_run: Path) -> Path:
+    return write_report(routine_run)
+
+
+@pytest.fixture(scope="module")
+def rl_eval_dir(tmp_path_factory) -> Path:
+    """An evaluation of the orbit baseline in short episodes, with its coverage picture."""
+    from seminspect.missions.learning.baselines import OrbitController
+    from seminspect.missions.learning.env import EnvConfig
+    from seminspect.missions.learning.evaluation import evaluate
+    from seminspect.report.figures import save_figure
+    from seminspect.report.rl import coverage_figure
+
+    out = tmp_path_factory.mktemp("rl")
+    short = EnvConfig(episode_seconds=2.0)
+    result = evaluate(OrbitController(), [0, 4], 2, 0, config=short, num_envs=2, policy="orbit")
+    result.to_json(out / "evaluation.json")
+    save_figure(coverage_figure({"orbit": result}), out / "coverage.png")
+    return out
+
+
+def _routine_counts(run_dir: Path) -> dict[str, int]:
+    """What the plan figure should hold, counted from the run's own files."""
+    import csv
+    import json
+
+    tasks = json.loads((run_dir / "tour.json").read_text())["tasks"]
+    with (run_dir / "views.csv").open() as handle:
+        flown = len(list(csv.DictReader(handle)))
+    return {
+        "Regions": len(tasks),
+        "Planned views": sum(len(task["views"]) for task in tasks),
+        "Views flown": flown,
+    }
+
+
+def test_routine_report_shows_the_plan_the_views_flown_and_the_tables(
+    routine_report: Path, routine_run: Path
+) -> None:
+    page = routine_report.read_text(encoding="utf-8")
+    layers = _figure_layers(page)
+    expected = _routine_counts(routine_run)
+    assert {k: layers[k] for k in expected} == expected
+    assert expected["Views flown"] > 0 and layers["M_H walls"] > 0
+    assert layers["added in M_C"] > 0  # the face advanced between M_H and M_C
+    for title in ("Figures (002 Sec V)", "Tasks", "Change report", "Algorithm 1 cycles"):
+        assert title in page
+    assert "<th>state</th><td>completed</td>" in page
+    # the two PNGs as embedded thumbnails, each a link to the picture beside the page
+    assert page.count("data:image/jpeg;base64,") == 2
+    links = {s for s in _external_sources(page) if not s.startswith("data:image/jpeg;base64,")}
+    assert links == {"changes.png", "performance.png"}  # no network, only files beside it
+    assert all((routine_run / link).is_file() for link in links)
+
+
+def test_a_routine_run_stopped_before_its_metrics_still_gets_a_page(
+    routine_run: Path, tmp_path: Path
+) -> None:
+    run_dir = tmp_path / "stopped"
+    shutil.copytree(routine_run, run_dir, ignore=shutil.ignore_patterns("*.html"))
+    (run_dir / "metrics.json").unlink()  # the tour file still says it is a routine run
+    page = write_report(run_dir).read_text(encoding="utf-8")
+    assert "wrote no metrics" in page
+    assert _figure_layers(page)["Planned views"] == _routine_counts(routine_run)["Planned views"]
+
+
+def test_a_compare_directory_gets_an_index_and_each_run_its_page(
+    routine_run: Path, tmp_path: Path
+) -> None:
+    for name in ("adaptive", "baseline"):
+        shutil.copytree(routine_run, tmp_path / name, ignore=shutil.ignore_patterns("*.html"))
+    assert run_kind(tmp_path) == "routine-compare"
+    page = write_report(tmp_path).read_text(encoding="utf-8")
+    for name in ("adaptive", "baseline"):
+        assert (tmp_path / name / REPORT_FILE).is_file()
+        assert f'href="{name}/{REPORT_FILE}"' in page
+    assert "adaptive vs baseline" in page and "viewing-distance MAE" in page
+
+
+def test_a_recorded_historical_map_gets_its_page(tmp_path: Path) -> None:
+    from seminspect.missions.routine.config import RoutineConfig
+    from seminspect.missions.routine.run import map_site
+
+    map_site(RoutineConfig(scenario="advancing", seed=0, length=12.0), tmp_path / "map", None)
+    assert run_kind(tmp_path / "map") == "routine-map"
+    page = write_report(tmp_path / "map").read_text(encoding="utf-8")
+    assert _figure_layers(page)["M_H walls"] > 0 and "occupied cells" in page
+
+
+def test_rl_report_has_a_curve_per_obstacle_count_and_every_episode(rl_eval_dir: Path) -> None:
+    from seminspect.missions.learning.evaluation import EvaluationResult
+
+    result = EvaluationResult.from_json(rl_eval_dir / "evaluation.json")
+    assert run_kind(rl_eval_dir) == "rl-eval"
+    page = write_report(rl_eval_dir).read_text(encoding="utf-8")
+    layers = _figure_layers(page)
+    for row in result.results:
+        assert layers[f"{row.obstacles} obstacles"] == len(row.curve_times)
+    episodes = sum(row.episodes for row in result.results)
+    assert layers["timeout (no crash)"] + layers["crashed"] == episodes
+    assert "004 Table I" in page and "92.1" in page and "82.6" in page  # the paper beside ours
+    assert page.count("data:image/jpeg;base64,") == 1  # coverage.png; no episode pictures here
+
+
+def test_run_kinds_are_told_apart_by_their_files(
+    mission_report: Path, terrain_report: Path, routine_run: Path
+) -> None:
+    assert run_kind(mission_report.parent) == "mission"
+    assert run_kind(terrain_report.parent) == "terrain"
+    assert run_kind(routine_run) == "routine"
+
+
+@pytest.mark.slow
+def test_routine_report_renders_in_a_browser(
+    routine_report: Path, routine_run: Path, tmp_path: Path
+) -> None:
+    traces, _, errors = _open_in_browser(routine_report, tmp_path / "routine.png", hover=False)
+    assert errors == []
+    layers = _by_layer(traces)
+    expected = _routine_counts(routine_run)
+    assert {k: layers[k]["points"] for k in expected} == expected
+
+
+@pytest.mark.slow
+def test_rl_report_renders_in_a_browser(rl_eval_dir: Path, tmp_path: Path) -> None:
+    report = write_report(rl_eval_dir)
+    traces, _, errors = _open_in_browser(report, tmp_path / "rl.png", "coverage", hover=False)
+    assert errors == []
+    layers = _by_layer(traces)
+    assert set(layers) == {"0 obstacles", "4 obstacles"}
     assert all(t["points"] == t["meta"]["nodes"] for t in layers.values())

@@ -29,3 +29,18 @@ def test_an_empty_run_directory_draws_empty_panels(tmp_path, run_dir):
     (tmp_path / "config.json").write_bytes((run_dir / "config.json").read_bytes())
     written = render_routine(tmp_path)
     assert [p.name for p in written] == ["performance.png"]
+
+
+def test_a_prior_of_another_format_is_compared_as_the_run_saved_it(tmp_path, run_dir):
+    """A .bt (or .ply, .pcd) prior is read as the run saved it beside M_C, so the change
+    report is drawn for it too."""
+    import json
+    import shutil
+
+    copy = tmp_path / "run"
+    shutil.copytree(run_dir, copy)
+    config = json.loads((copy / "config.json").read_text())
+    config["config"]["prior"] = str(tmp_path / "elsewhere" / "site.bt")  # not there: not read
+    (copy / "config.json").write_text(json.dumps(config))
+    written = render_routine(copy)
+    assert {p.name for p in written} == {"performance.png", "changes.png"}

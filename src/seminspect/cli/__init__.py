@@ -37,10 +37,11 @@ GROUPS: tuple[tuple[str, str, str], ...] = (
     ("graph", "graph", "Inspect, query and export 3D Layered Semantic Graphs."),
     ("terrain", "terrain", "Terrain-aware, task-driven outdoor scene graphs (paper 001)."),
     ("routine", "routine", "Routine inspection on an outdated map: adaptive planning (paper 002)."),
-    ("world", "world", "List, draw and export the built-in simulated worlds."),
+    ("world", "world", "List, draw, check and export worlds: the built-in ones and users' sites."),
     ("bench", "bench", "Studies that reproduce the papers' comparisons (planning: 000 Table 5)."),
     ("sweep", "sweep", "Many missions (worlds x scenarios x seeds x settings) on Ray, one table."),
     ("rl", "rl", "Learned semantic inspection in rooms: evaluate and show (paper 004)."),
+    ("plan", "plan", "A volumetric path between two points on a map file (.bt, .npz, .ply, .pcd)."),
     ("view", "view", "Open a run's report.html (3D graph, tables, plots) in the browser."),
 )
 

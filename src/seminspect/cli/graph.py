@@ -7,18 +7,21 @@ directory) or the word ``example`` for the small graph shipped with the package.
 from __future__ import annotations
 
 import json
+from collections.abc import Iterable
 from enum import Enum
-from importlib.resources import files
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import typer
+from rich.console import Console
 from rich.table import Table
+from rich.tree import Tree
 
 from seminspect.cli._common import console, writable_file
 
 if TYPE_CHECKING:
     from seminspect.graphs.lsg.graph import LayeredSemanticGraph
+    from seminspect.graphs.lsg.model import FeatureNode, LevelNode, PoseNode, TargetNode
     from seminspect.planning.hierarchical import RoutePlan
 
 app = typer.Typer(no_args_is_help=True, add_completion=False)
@@ -30,7 +33,9 @@ EXAMPLE = "example"
 
 def example_graph_path() -> Path:
     """Location of the example graph inside the installed package."""
-    return Path(str(files("seminspect") / "data" / "example_graph.json"))
+    from seminspect.graphs.lsg.io import example_graph_path as shipped
+
+    return shipped()
 
 
 def _load(source: str) -> LayeredSemanticGraph:
@@ -76,6 +81,76 @@ def info(graph_file: str = typer.Argument(..., metavar="FILE", help=GRAPH_HELP))
             z,
         )
     console.print(targets)
+
+
+@app.command()
+def tree(
+    graph_file: str = typer.Argument(..., metavar="FILE", help=GRAPH_HELP),
+    depth: int = typer.Option(
+        4, "--depth", "-d", min=1, max=4, help="1 targets, 2 levels, 3 poses, 4 features."
+    ),
+    target: str | None = typer.Option(None, "--target", "-t", help="Show this target only."),
+) -> None:
+    """Print the hierarchy Target -> Level -> Pose -> Feature with each node's key attributes."""
+    graph = _load(graph_file)
+    targets = [graph.target(target)] if target else graph.targets()
+    hierarchy = graph_tree(graph_file, targets, depth)
+    # one node per line, however narrow the terminal: a line is something to grep
+    wide = Console(file=console.file, markup=False, width=max(console.width, _widest(hierarchy)))
+    wide.print(hierarchy)
+
+
+def graph_tree(title: str, targets: list[TargetNode], depth: int) -> Tree:
+    """The hierarchy under ``targets`` down to ``depth`` layers (1 = targets only)."""
+    root = Tree(f"{title}: {_count(len(targets), 'target')}")
+    for target in targets:
+        branch = root.add(_target_line(target))
+        for level in target.levels if depth > 1 else []:
+            twig = branch.add(_level_line(level))
+            for pose in level.poses if depth > 2 else []:
+                leaf = twig.add(_pose_line(pose))
+                for feature in pose.features if depth > 3 else []:
+                    leaf.add(_feature_line(feature))
+    return root
+
+
+def _widest(node: Tree, indent: int = 0) -> int:
+    """Columns the tree needs so that no label wraps (rich indents each level by 4)."""
+    own = indent + len(str(node.label))
+    return max([own, *(_widest(child, indent + 4) for child in node.children)])
+
+
+def _target_line(target: TargetNode) -> str:
+    return (
+        f"{target.id}  {target.label}, {target.status.value}, "
+        f"{_count(len(target.levels), 'level')}, {_xyz(target.position)}, "
+        f"score {target.score:.2f}"
+    )
+
+
+def _level_line(level: LevelNode) -> str:
+    return f"{level.name}  {_count(len(level.poses), 'pose')}, {_xyz(level.position)}"
+
+
+def _pose_line(pose: PoseNode) -> str:
+    image = f", {pose.image}" if pose.image else ""
+    return (
+        f"{pose.name}  {_xyz(pose.position)}, yaw {pose.yaw:.2f}, "
+        f"{_count(len(pose.features), 'feature')}{image}"
+    )
+
+
+def _feature_line(feature: FeatureNode) -> str:
+    return f"{feature.name}  {feature.label}, score {feature.score:.2f}, {_xyz(feature.position)}"
+
+
+def _xyz(position: Iterable[float]) -> str:
+    x, y, z = (float(c) for c in position)
+    return f"({x:.2f}, {y:.2f}, {z:.2f})"
+
+
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}" + ("" if n == 1 else "s")
 
 
 @app.command()
@@ -164,12 +239,14 @@ class ExportFormat(str, Enum):
     graphml = "graphml"
     json = "json"
     spark_dsg = "spark-dsg"
+    csv = "csv"
 
 
 _SUFFIX = {
     ExportFormat.graphml: ".graphml",
     ExportFormat.json: ".json",
     ExportFormat.spark_dsg: ".dsg.json",
+    ExportFormat.csv: "_csv",
 }
 
 
@@ -178,17 +255,28 @@ def export(
     graph_file: str = typer.Argument(..., metavar="FILE", help=GRAPH_HELP),
     fmt: ExportFormat = typer.Option(ExportFormat.graphml, "--format", "-f", help="Output format."),
     out: Path | None = typer.Option(
-        None, "--out", "-o", help="Output file (default: beside FILE)."
+        None,
+        "--out",
+        "-o",
+        help="Output file, or folder for csv (default: beside FILE).",
     ),
 ) -> None:
-    """Write the graph as GraphML, seminspect JSON or a spark-dsg scene graph."""
+    """Write the graph as GraphML, seminspect JSON, a spark-dsg scene graph or CSV tables
+    (targets, levels, poses, features and each layer's edges; columns in docs/scene-graph.md)."""
     from seminspect.graphs.lsg.io import export_graphml, export_spark_dsg, save_graph
+    from seminspect.graphs.lsg.tables import export_csv
 
     source = Path("example_graph.json") if graph_file == EXAMPLE else Path(graph_file)
-    target = writable_file(out or source.with_name(source.stem + _SUFFIX[fmt]))
+    target = out or source.with_name(source.stem + _SUFFIX[fmt])
+    if fmt is not ExportFormat.csv:
+        writable_file(target)
     if target.resolve() == source.resolve():
         raise typer.BadParameter("the output would overwrite the input; pass --out")
     graph = _load(graph_file)
+    if fmt is ExportFormat.csv:
+        written = export_csv(graph, target)
+        console.print(f"wrote {len(written)} tables to {target}")
+        return
     writer = {
         ExportFormat.graphml: export_graphml,
         ExportFormat.json: save_graph,

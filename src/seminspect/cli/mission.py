@@ -78,6 +78,12 @@ _RESUME_OPTION = typer.Option(
 _BAG_OPTION = typer.Option(
     None, "--bag", help="Replay the run's LiDAR stream into this new ROS2 bag (directory)."
 )
+_FEATURES_OPTION = typer.Option(
+    None,
+    "--features",
+    help="Parts recorded as features, comma-separated (default: every part the world's "
+    "targets carry besides body, roof and wall).",
+)
 _ROBOTS_OPTION = typer.Option(
     None,
     "--robots",
@@ -102,6 +108,7 @@ def app(
     resume: Path | None = _RESUME_OPTION,
     bag: Path | None = _BAG_OPTION,
     robots: str | None = _ROBOTS_OPTION,
+    features: str | None = _FEATURES_OPTION,
 ) -> None:
     """Explore a site, inspect every target level by level and build its 3DLSG (paper 000).
 
@@ -123,6 +130,7 @@ def app(
                 "noise": noise.value, "planner": planner.value, "time_budget_s": budget,
                 "map_carving_spacing": carving_spacing,
                 "robots": None if robots is None else [r.strip() for r in robots.split(",")],
+                "feature_labels": _names(features),
             }
         )  # fmt: skip
         if out is not None:
@@ -135,6 +143,11 @@ def app(
     _print_result(result)
     if result.state == "interrupted":
         exit_stopped(result.stop_signal, result.run_dir)
+
+
+def _names(text: str | None) -> list[str] | None:
+    """A comma-separated option as a list (None when not given)."""
+    return None if text is None else [name.strip() for name in text.split(",") if name.strip()]
 
 
 def _world_argument(world: str) -> str:
@@ -260,11 +273,9 @@ def _print_result(result) -> None:
 
 def _outputs(run_dir: Path) -> list[str]:
     """The run's main outputs that exist, so the results line promises nothing absent."""
-    named = [
-        name for name in ("report.html", "summary.md", "graph.json") if (run_dir / name).exists()
-    ]
-    pictures = len(list(run_dir.glob("*.png")))
-    return named + ([f"{pictures} pictures (*.png)"] if pictures else ["no pictures"])
+    from seminspect.report.html import existing_outputs
+
+    return existing_outputs(run_dir, ("report.html", "summary.md", "graph.json"))
 
 
 def _m(value: float | None) -> str:

@@ -89,13 +89,16 @@ def eval_command(
     seed: int = _SEED,
     envs: int = _ENVS,
     threads: int = _THREADS,
-    out: Path = typer.Option(..., "--out", "-o", help="Directory for evaluation.json and PNGs."),
+    out: Path = typer.Option(
+        ..., "--out", "-o", help="Directory for evaluation.json, report.html and PNGs."
+    ),
 ) -> None:
     """Coverage, crash % and timeout % per obstacle count, beside 004 Table I."""
     from seminspect.cli._common import writable_directory
     from seminspect.core.errors import InvalidInputError
     from seminspect.missions.learning.evaluation import EpisodeTrace, evaluate
     from seminspect.report.figures import save_figure
+    from seminspect.report.html import existing_outputs, write_rl_report
     from seminspect.report.rl import coverage_figure, write_episode_pictures
 
     counts = parse_obstacles(obstacles)
@@ -132,8 +135,11 @@ def eval_command(
             prefix=f"episode_{count:02d}",
             title=f"{name}, {count} obstacles",
         )
+    write_rl_report(out)
     _print_table(result)
-    console.print(f"{result.wall_seconds:.1f} s; results: {out} (evaluation.json, *.png)")
+    # unwrapped: paths are copied from this line
+    outputs = ", ".join(existing_outputs(out, ("report.html", "evaluation.json")))
+    console.print(f"{result.wall_seconds:.1f} s; results: {out}  ({outputs})", soft_wrap=True)
 
 
 def _print_table(result) -> None:

@@ -11,7 +11,12 @@ from seminspect.cli._common import console, exit_stopped, labelled, progress_bar
 
 app = typer.Typer(no_args_is_help=True, help="Routine inspection on an outdated map (002).")
 
-_WORLD = typer.Option("mine-drift", "--world", "-w", help="Site (mine-drift).")
+_WORLD = typer.Option(
+    "mine-drift",
+    "--world",
+    "-w",
+    help="Site: mine-drift, or an OctoMap (.bt) whose voxels make the site and M_H.",
+)
 _SCENARIO = typer.Option(
     "nominal", "--scenario", "-s", help="nominal, receding, advancing or obstructed."
 )
@@ -32,8 +37,14 @@ def _config_and_site(world, scenario, seed, length, historical, current, *, need
     """The settings, and the user's site pair when --historical/--current are given."""
     from seminspect.core.errors import InvalidInputError
     from seminspect.missions.routine.config import RoutineConfig
+    from seminspect.missions.routine.map_site import SITE_KIND, is_map_file, map_site
     from seminspect.worlds.routine_sites import user_site, world_files
 
+    if is_map_file(world):
+        if historical is not None or current is not None:
+            raise InvalidInputError("--world MAP builds the site: leave out --historical/--current")
+        config = RoutineConfig(world=SITE_KIND, scenario=SITE_KIND, seed=seed, length=length)
+        return config, map_site(world, config)
     if historical is None and current is None:
         return RoutineConfig(world=world, scenario=scenario, seed=seed, length=length), None
     if historical is None or (need_current and current is None):
@@ -62,7 +73,8 @@ def map_command(
         task = bar.add_task("mapping M_H", total=1.0)
         path = map_site(config, out, lambda share: bar.update(task, completed=share), site)
     console.print(f"M_H recorded: {path}")
-    console.print(f"inspect with: seminspect routine inspect --scenario {scenario} --prior {path}")
+    site_option = f"--world {world}" if config.world == "map" else f"--scenario {scenario}"
+    console.print(f"inspect with: seminspect routine inspect {site_option} --prior {path}")
 
 
 @app.command("inspect")
@@ -91,9 +103,12 @@ def inspect_command(
     """Inspect the scenario's regions in the current world with a plan made on M_H."""
     from seminspect.missions.routine.run import PRIOR_FILE, run_routine
     from seminspect.report.figures import save_figure
+    from seminspect.report.html import write_routine_comparison_report, write_routine_report
     from seminspect.report.routine import comparison_figure, render_routine
 
     base, site = _config_and_site(world, scenario, seed, length, historical, current)
+    if prior is None and base.world == "map":
+        prior = Path(world)  # the map is M_H too: nothing to record
     runs = {"adaptive": True, "baseline": False} if compare else {"": adapt}
     results = {}
     shared_prior = prior
@@ -117,11 +132,15 @@ def inspect_command(
     if pictures and all(r.stop_signal != signal.SIGTERM for r in results.values()):
         for result in results.values():
             render_routine(result.run_dir)
+            write_routine_report(result.run_dir)
         if compare and len(results) == len(runs):
             figure = comparison_figure({n: r.run_dir for n, r in results.items()})
             save_figure(figure, out / "comparison.png")
+            write_routine_comparison_report(out)
     for name, result in results.items():
         _print_result(name, result)
+    if compare and (out / "report.html").exists():
+        console.print(f"compared: {out / 'report.html'}", soft_wrap=True)
     stopped = [r for r in results.values() if r.state == "interrupted"]
     if stopped:
         exit_stopped(stopped[0].stop_signal, out)
@@ -139,7 +158,14 @@ def _print_result(name: str, result) -> None:
         f"{_num(m.view_distance_mae_m)} m, ROI coverage {_num(m.roi_coverage_pct, 1)} %, "
         f"max Γ_s {_num(m.gamma_s_max)}, collisions {m.collisions}"
     )
-    console.print(f"  results: {result.run_dir} (summary.md, metrics.json, *.png)")
+    from seminspect.report.html import existing_outputs
+
+    # unwrapped: paths are copied from this line; it names only what the run holds
+    outputs = ", ".join(existing_outputs(result.run_dir, _OUTPUTS))
+    console.print(f"  results: {result.run_dir} ({outputs})", soft_wrap=True)
+
+
+_OUTPUTS = ("report.html", "summary.md", "metrics.json")
 
 
 def _num(value: float | None, digits: int = 2) -> str:

@@ -9,6 +9,14 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from seminspect.cli._common import console, labelled, writable_directory, writable_file
+from seminspect.cli.terrain_input import (
+    OBJECTS_DEFAULT,
+    TERRAIN_DEFAULT,
+    bare_object_params,
+    check_labels_from,
+    load_cloud,
+    task_prompts,
+)
 
 if TYPE_CHECKING:
     from seminspect.graphs.terrain.evaluate import ObjectQuality
@@ -18,8 +26,10 @@ app = typer.Typer(no_args_is_help=True, help="Terrain-aware, task-driven outdoor
 _GRAPH_HELP = """Build the task-driven scene graph (001 Sec III-B) of a cloud or scans.
 
 
-INPUT is a .ply/.pcd/.npz cloud with per-point embeddings or labels, a semantic cloud saved by
-seminspect, or SemanticKITTI .bin scans with --labels (one per scan, same order)."""
+INPUT is a .ply/.pcd/.npz/.las/.laz cloud with per-point embeddings or labels, a semantic cloud
+saved by seminspect, or SemanticKITTI .bin scans with --labels (one per scan, same order). A
+cloud with neither (a bare LiDAR survey) takes the geometric path: a ground filter and object
+clustering label it 'ground' and 'object', and the prompts default to those two."""
 
 # Options that do not fit on the command's line, and those both commands share.
 _ENCODER_OPTION = typer.Option(
@@ -30,7 +40,22 @@ _ENCODER_OPTION = typer.Option(
 )
 _RADIUS_OPTION = typer.Option(0.15, help="Association radius of scan points to map points [m].")
 _OBJECTS_OPTION = typer.Option(
-    "image of a tree,image of a car", help="Object prompts, comma-separated."
+    None, help=f"Object prompts, comma-separated [default: {OBJECTS_DEFAULT}; bare: object]."
+)
+_TERRAIN_OPTION = typer.Option(
+    None, help=f"Terrain prompts, comma-separated [default: {TERRAIN_DEFAULT}; bare: ground]."
+)
+_UNITS_OPTION = typer.Option(
+    None,
+    "--units",
+    help="Units of the point file's coordinates: m, ft (0.3048 m) or us-ft (1200/3937 m) "
+    "[default: the LAS header's, else m].",
+)
+_LABELS_FROM_OPTION = typer.Option(
+    None,
+    "--labels-from",
+    help="'classification': take a LAS file's ASPRS classes as labels instead of the "
+    "geometric path.",
 )
 _CLOUD_LABEL_NAMES_OPTION = typer.Option(
     None, help="Names of a cloud's integer labels, e.g. '0=grass,1=car'."
@@ -71,53 +96,6 @@ def _param_overrides(items: list[str], cell_size: float | None) -> dict[str, Any
     if cell_size is not None:
         values["cell_size"] = cell_size
     return values
-
-
-def _load_cloud(inputs: list[Path], labels: list[Path], options: dict[str, Any], encoder, progress):
-    """The phase-1 cloud, and fused KITTI labels when the input is scans (else ``None``)."""
-    from seminspect.core.errors import InvalidInputError
-    from seminspect.mapping.formats.pointfiles import label_names_from_text, load_point_file
-    from seminspect.mapping.formats.semantickitti import (
-        fuse_kitti_scans,
-        read_calib,
-        read_poses,
-        velodyne_poses,
-    )
-    from seminspect.mapping.ingest import cloud_from_point_data
-    from seminspect.mapping.semantic_cloud import cloud_from_arrays, is_cloud_file, read_npz
-
-    if all(path.suffix.lower() == ".bin" for path in inputs):
-        if len(labels) != len(inputs):
-            raise InvalidInputError("give one --labels file per SemanticKITTI scan")
-        poses = None
-        if options["poses"] is not None or options["calib"] is not None:
-            if options["poses"] is None or options["calib"] is None:
-                raise InvalidInputError("--poses and --calib go together")
-            tr = read_calib(options["calib"])["Tr"]
-            poses = velodyne_poses(read_poses(options["poses"]), tr)
-        task = progress.add_task("phase 1: fusing scans", total=len(inputs))
-        fused = fuse_kitti_scans(
-            list(zip(inputs, labels, strict=True)),
-            poses,
-            encoder,
-            options["radius"],
-            on_scan=lambda _: progress.advance(task),
-        )
-        return fused.cloud, fused
-    if len(inputs) != 1 or labels:
-        raise InvalidInputError("give one cloud file (several inputs and --labels are for scans)")
-    source = inputs[0]
-    if source.suffix.lower() == ".npz":
-        arrays = read_npz(source)
-        if is_cloud_file(arrays):
-            cloud = cloud_from_arrays(source, arrays)
-            if cloud.encoder != encoder.name:
-                raise InvalidInputError(
-                    f"{source} was embedded by {cloud.encoder!r}; pass --encoder {cloud.encoder}"
-                )
-            return cloud, None
-    names = label_names_from_text(options["label_names"]) if options["label_names"] else None
-    return cloud_from_point_data(load_point_file(source), encoder, names), None
 
 
 def _positive_radius(radius: float) -> None:
@@ -260,7 +238,9 @@ def _slug(text: str) -> str:
     return "".join(ch if ch.isalnum() else "_" for ch in text).strip("_") or "terrain"
 
 
-def _write_summary(out: Path, cloud, build, quality: dict[str, Any] | None) -> dict[str, Any]:
+def _write_summary(
+    out: Path, cloud, build, quality: dict[str, Any] | None, extra: dict[str, Any] | None = None
+) -> dict[str, Any]:
     """``summary.json`` and ``report.html`` of a graph directory; returns the summary."""
     import json
 
@@ -272,6 +252,7 @@ def _write_summary(out: Path, cloud, build, quality: dict[str, Any] | None) -> d
         **build.scene.summary(),
         "seconds": build.timings,
         "quality": quality,
+        **(extra or {}),
     }
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2) + "\n")
     write_terrain_report(out)
@@ -284,15 +265,16 @@ def _print_graph_summary(out: Path, summary: dict[str, Any]) -> None:
     console.print(
         labelled("terrain graph", "bold", f"written to {out} (open report.html in a browser)")
     )
-    console.print_json(json.dumps({k: v for k, v in summary.items() if k != "seconds"}))
+    hidden = ("seconds", "frame", "geometric_path")
+    console.print_json(json.dumps({k: v for k, v in summary.items() if k not in hidden}))
 
 
 @app.command("graph", help=_GRAPH_HELP)
 def graph(
     inputs: list[Path] = typer.Argument(..., help="Cloud file, or SemanticKITTI .bin scans."),
     out: Path = typer.Option(..., "--out", help="Directory for the graph, summary and pictures."),
-    terrain: str = typer.Option("sidewalk,grass,asphalt", help="Terrain prompts, comma-separated."),
-    objects: str = _OBJECTS_OPTION,
+    terrain: str | None = _TERRAIN_OPTION,
+    objects: str | None = _OBJECTS_OPTION,
     labels: list[Path] = typer.Option([], "--labels", help="SemanticKITTI .label, one per scan."),
     poses: Path | None = typer.Option(None, help="KITTI poses.txt (fuses several scans)."),
     calib: Path | None = typer.Option(None, help="KITTI calib.txt (with --poses)."),
@@ -303,25 +285,35 @@ def graph(
     radius: float = _RADIUS_OPTION,
     terrain_threshold: float | None = typer.Option(None, help="Override the terrain threshold."),
     object_threshold: float | None = typer.Option(None, help="Override α, the object threshold."),
-    cell_size: float | None = typer.Option(None, help="Terrain grid cell size [m]."),
+    cell_size: float | None = typer.Option(
+        None,
+        help="Terrain grid cell size [m] (default 0.5; three point spacings for clouds "
+        "sparser than 0.4 m).",
+    ),
     param: list[str] = typer.Option([], help="Any graph parameter as NAME=VALUE (repeatable)."),
     evaluate: bool = _EVALUATE_OPTION,
+    units: str | None = _UNITS_OPTION,
+    labels_from: str | None = _LABELS_FROM_OPTION,
 ) -> None:
     from rich.progress import Progress
 
     from seminspect.graphs.terrain.params import make_terrain_params
-    from seminspect.graphs.terrain.prompting import TaskPrompts
     from seminspect.graphs.terrain.scene_graph import build_terrain_graph
+    from seminspect.mapping.local_frame import check_units
 
     writable_directory(out)
     _positive_radius(radius)
-    prompts = TaskPrompts.parse(terrain, objects)
-    params = make_terrain_params(_param_overrides(param, cell_size))
+    check_labels_from(labels_from)
+    given = _param_overrides(param, cell_size)
+    make_terrain_params(given)  # a bad --param fails before the cloud is read
     encoder = _encoder(encoder_name, noise, seed)
     calibration = _calibration(encoder.name, terrain_threshold, object_threshold)
-    options = {"poses": poses, "calib": calib, "radius": radius, "label_names": label_names}
+    options = {"poses": poses, "calib": calib, "radius": radius, "label_names": label_names,
+               "units": check_units(units), "labels_from": labels_from}  # fmt: skip
     with Progress(console=console, transient=True) as progress:
-        cloud, fused = _load_cloud(inputs, labels, options, encoder, progress)
+        cloud, fused, extra = load_cloud(inputs, labels, options, encoder, progress)
+        prompts = task_prompts(terrain, objects, bare="geometric_path" in extra)
+        params = make_terrain_params(bare_object_params(extra, given))
         if evaluate:
             _require_truth(cloud, fused)
         on_stage = _stage_reporter(progress)
@@ -330,7 +322,9 @@ def graph(
         )
         quality = _quality(build, cloud, fused, encoder) if evaluate else None
         _write_outputs(out, build, cloud, progress)
-    _print_graph_summary(out, _write_summary(out, cloud, build, quality))
+    if build.choice is not None and build.choice.derived:  # say what the spacing changed
+        console.print(labelled("parameters:", "bold", build.choice.describe()), soft_wrap=True)
+    _print_graph_summary(out, _write_summary(out, cloud, build, quality, extra))
 
 
 @app.command("route")

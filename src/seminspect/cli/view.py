@@ -29,7 +29,11 @@ def make_server(root: Path, port: int) -> http.server.ThreadingHTTPServer:
 
 
 def app(
-    run_dir: Path = typer.Argument(..., help="A mission or terrain run directory."),
+    run_dir: Path = typer.Argument(
+        ...,
+        help="A run directory: mission, terrain graph, routine inspection (run, routine map or "
+        "--compare directory) or rl eval.",
+    ),
     port: int = typer.Option(8765, "--port", help="Port on localhost (0: any free one).", min=0),
     browser: bool = typer.Option(
         True, "--browser/--no-browser", help="Open the page in the default browser."
@@ -40,7 +44,8 @@ def app(
 ) -> None:
     """Serve a run's report.html on localhost and open it (Ctrl-C stops the server).
 
-    report.html is written first when the run has none (runs made with --no-pictures).
+    report.html is written first when the run has none (runs made with --no-pictures, or
+    before their program wrote one).
     """
     import webbrowser
 

@@ -27,3 +27,11 @@ VEHICLE_PARTS: tuple[str, ...] = (
 
 #: The inspection features of a collapsed building (000 Sec VI-B, Table 2 scenario).
 BUILDING_FEATURES: tuple[str, ...] = ("window", "person", "rubble")
+
+#: Parts that are the object itself, not features on it: a vehicle's ``body`` and ``roof``, a
+#: building's ``wall`` and ``roof``. The built-in worlds name these and the features above, and
+#: a world's feature labels are its targets' parts without these (missions.xflie.features).
+STRUCTURE_PARTS: tuple[str, ...] = ("body", "roof", "wall")
+
+#: The built-in features in their published order, which orders a world's feature labels.
+KNOWN_FEATURES: tuple[str, ...] = VEHICLE_PARTS + BUILDING_FEATURES

@@ -15,7 +15,9 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.spatial import cKDTree
 
+from seminspect.core.rng import make_rng
 from seminspect.geometry.transforms import as_point, as_points
 
 #: Points per bucket the grid is sized for.
@@ -83,3 +85,33 @@ def _nearest(points, origin, cell, shape, starts, order, p):  # noqa: PLR0917
         if best >= 0 and best_d2 <= (ring * cell) ** 2:
             break
     return best, math.sqrt(best_d2)
+
+
+#: Points whose nearest neighbour is measured for the median spacing (a seeded sample).
+_SPACING_SAMPLE = 20_000
+#: Coincident points (repeated returns at one position) looked past for the nearest other one.
+_SPACING_TWINS = 4
+
+
+def median_spacing(points: ArrayLike, *, planar: bool = False, seed: int = 0) -> float:
+    """Median distance from a seeded sample of points to their nearest other position (x-y
+    only with ``planar``), or NaN when fewer than two distinct positions exist.
+
+    The sample queries a tree over every point, so subsampling does not inflate the distances;
+    a point's coincident twins (several returns at one position) are skipped.
+    """
+    cloud = np.asarray(points, dtype=np.float64)
+    cloud = cloud[:, :2] if planar else cloud
+    if cloud.shape[0] < 2:
+        return math.nan
+    sample = cloud
+    if cloud.shape[0] > _SPACING_SAMPLE:
+        rows = make_rng(seed, "geometry", "spacing").choice(
+            cloud.shape[0], _SPACING_SAMPLE, replace=False
+        )
+        sample = cloud[rows]
+    tree = cKDTree(cloud, balanced_tree=False, compact_nodes=False)
+    distance, _ = tree.query(sample, k=min(_SPACING_TWINS + 2, cloud.shape[0]))
+    apart = np.where(distance[:, 1:] > 1e-9, distance[:, 1:], np.inf).min(axis=1)
+    apart = apart[np.isfinite(apart)]
+    return float(np.median(apart)) if apart.size else math.nan

@@ -9,6 +9,7 @@ posed views averages these per map point exactly as camera segments are averaged
 from __future__ import annotations
 
 from collections.abc import Collection, Mapping
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -16,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from seminspect.core.errors import InvalidInputError
 from seminspect.geometry.transforms import as_points
 from seminspect.mapping.formats.pointfiles import PointData
+from seminspect.mapping.ground import BareCloudLabels, GroundFilterParams, label_bare_cloud
 from seminspect.mapping.semantic_cloud import (
     IntegrationStats,
     SemanticCloud,
@@ -54,27 +56,58 @@ def label_embeddings(
 
 
 def cloud_from_point_data(
-    data: PointData, encoder: Encoder, names: Mapping[int, str] | None = None
+    data: PointData,
+    encoder: Encoder,
+    names: Mapping[int, str] | None = None,
+    source: str | Path | None = None,
 ) -> SemanticCloud:
-    """A single-view cloud: per-point embeddings as given, or embedded labels."""
+    """A single-view cloud: per-point embeddings as given, or embedded labels.
+
+    ``source`` (the file the data came from) names it in the error lines.
+    """
+    where = f"{source}: " if source is not None else ""
     if data.embeddings is not None:
         if data.embeddings.shape[1] != encoder.dim:
             raise InvalidInputError(
-                f"the file's embeddings have {data.embeddings.shape[1]} dimensions, "
+                f"{where}the file's embeddings have {data.embeddings.shape[1]} dimensions, "
                 f"encoder {encoder.name!r} makes {encoder.dim}"
             )
         counts = np.ones(data.points.shape[0], np.int64)
         return SemanticCloud(data.points, data.embeddings, counts, encoder.name)
     if data.labels is None:
-        raise InvalidInputError("the point file has neither per-point embeddings nor labels")
-    index, embeddings = label_embeddings(
-        data.labels, {**data.label_names, **(names or {})}, encoder
-    )
+        raise InvalidInputError(
+            f"{where}the point file has neither per-point embeddings nor labels "
+            "(label_bare_points gives a bare cloud ground and object labels)"
+        )
+    try:
+        index, embeddings = label_embeddings(
+            data.labels, {**data.label_names, **(names or {})}, encoder
+        )
+    except InvalidInputError as exc:
+        raise InvalidInputError(f"{where}{exc}") from None
     if index.size == 0:
-        raise InvalidInputError("no point carries a meaningful label")
+        raise InvalidInputError(f"{where}no point carries a meaningful label")
     return SemanticCloud(
         data.points[index], embeddings, np.ones(index.size, np.int64), encoder.name
     )
+
+
+def label_bare_points(
+    data: PointData,
+    params: GroundFilterParams | None = None,
+    seed: int = 0,
+    source: str | Path | None = None,
+) -> tuple[PointData, BareCloudLabels]:
+    """The geometric path for a cloud without labels or embeddings: ground, object and
+    outlier labels from the ground filter and the object clustering (``mapping.ground``).
+
+    ``source`` (the file the data came from) names it in the error lines.
+    """
+    try:
+        bare = label_bare_cloud(data.points, params, seed)
+    except InvalidInputError as exc:
+        raise InvalidInputError(f"{source}: {exc}" if source is not None else str(exc)) from None
+    return PointData(data.points, labels=bare.labels, label_names=bare.names), bare
 
 
 def integrate_labelled_scan(

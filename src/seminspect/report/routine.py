@@ -15,9 +15,10 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
+from numpy.typing import NDArray
 
 from seminspect.core.io import read_versioned_json
-from seminspect.mapping.voxel import OCCUPIED, load_map
+from seminspect.mapping.voxel import OCCUPIED, VoxelMap, load_map
 from seminspect.missions.routine.measures import change_masks
 from seminspect.missions.routine.run import PRIOR_FILE, TOUR_FORMAT
 from seminspect.report.figures import new_figure, save_figure
@@ -99,30 +100,60 @@ def comparison_figure(runs: dict[str, Path]) -> Figure:
     return figure
 
 
-def changes_figure(run_dir: Path) -> Figure | None:
-    """Top-down change report; None without both maps (e.g. a prior given by another file
-    whose grid differs from M_C's)."""
+def change_maps(run_dir: Path) -> tuple[VoxelMap, VoxelMap] | None:
+    """``(M_H, M_C)`` of a run, or None without both on one grid (e.g. a prior given by another
+    file whose grid differs from M_C's). A prior given as a ``.npz`` is read where it was given;
+    one of another format (.bt, .ply, .pcd) is read as the run saved it, on its own grid."""
     prior_path = run_dir / PRIOR_FILE
-    config = read_run_config(run_dir)
-    if config.get("prior"):
-        prior_path = Path(config["prior"])
+    given = read_run_config(run_dir).get("prior")
+    if given and Path(given).suffix.lower() == ".npz":
+        prior_path = Path(given)
     current_path = run_dir / "map.npz"
     if not (prior_path.suffix == ".npz" and prior_path.exists() and current_path.exists()):
         return None
     prior, current = load_map(prior_path), load_map(current_path)
     if prior.states.shape != current.states.shape:
         return None
+    return prior, current
+
+
+def wall_band(voxels: VoxelMap) -> NDArray[np.bool_]:
+    """The map's z layers drawn as walls from above: no floor, no roof."""
+    heights = voxels.origin[2] + (np.arange(voxels.shape[2]) + 0.5) * voxels.resolution
+    return (heights > WALL_BAND_M[0]) & (heights < WALL_BAND_M[1])
+
+
+def wall_columns(voxels: VoxelMap) -> NDArray[np.bool_]:
+    """``(ny, nx)``, image order: the columns holding an occupied cell within the wall band."""
+    return (voxels.states[:, :, wall_band(voxels)] == OCCUPIED).any(axis=2).T
+
+
+def change_centres(prior: VoxelMap, current: VoxelMap) -> dict[str, NDArray[np.float64]]:
+    """Centres (at z of the grid's first layer) of the columns whose wall-band cells turned
+    occupied (``added``) or free (``removed``) in M_C."""
     added, removed = change_masks(prior, current)
+    band = wall_band(prior)
+    centres = {}
+    for name, mask in (("added", added), ("removed", removed)):
+        columns = np.argwhere(mask[:, :, band].any(axis=2))
+        centres[name] = prior.index_to_world(np.column_stack([columns, np.zeros(len(columns))]))
+    return centres
+
+
+def changes_figure(run_dir: Path) -> Figure | None:
+    """Top-down change report; None without both maps (:func:`change_maps`)."""
+    maps = change_maps(run_dir)
+    if maps is None:
+        return None
+    prior, current = maps
     figure = new_figure(11, 4)
     ax = figure.add_subplot()
     extent = (prior.origin[0], prior.upper[0], prior.origin[1], prior.upper[1])
-    heights = prior.origin[2] + (np.arange(prior.shape[2]) + 0.5) * prior.resolution
-    band = (heights > WALL_BAND_M[0]) & (heights < WALL_BAND_M[1])  # no floor, no roof
-    walls = (prior.states[:, :, band] == OCCUPIED).any(axis=2).T
+    walls = wall_columns(prior)
     ax.imshow(walls, origin="lower", extent=extent, cmap="Greys", alpha=0.35, aspect="equal")
-    for mask, colour, name in ((added, "tab:red", "added"), (removed, "tab:blue", "removed")):
-        columns = np.argwhere(mask[:, :, band].any(axis=2))
-        centres = prior.index_to_world(np.column_stack([columns, np.zeros(len(columns))]))
+    changes = change_centres(prior, current)
+    for colour, name in (("tab:red", "added"), ("tab:blue", "removed")):
+        centres = changes[name]
         ax.scatter(centres[:, 0], centres[:, 1], s=4, color=colour, label=f"{name} in M_C")
     _draw_tours(ax, run_dir)
     trajectory = load_trajectory(run_dir)

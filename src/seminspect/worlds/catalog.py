@@ -11,8 +11,14 @@ from typing import Any
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.names import unknown_name
 from seminspect.worlds import campus, city, collapsed, outdoor, rooms
+from seminspect.worlds.sdf import SDF_SUFFIXES
 from seminspect.worlds.underground import generate_mine_drift, generate_subterranean
-from seminspect.worlds.user import LABELS_SUFFIXES, MESH_SUFFIXES, load_world_path
+from seminspect.worlds.user import (
+    LABELS_SUFFIXES,
+    MESH_SUFFIXES,
+    OCTOMAP_SUFFIXES,
+    load_world_path,
+)
 from seminspect.worlds.world import World
 
 
@@ -130,8 +136,9 @@ def generate_world(name: str, scenario: str | None = None, seed: int = 0, **opti
 
 
 def open_world(name_or_path: str, scenario: str | None = None, seed: int = 0) -> World:
-    """A built-in world by name, or a user world by path (see ``worlds.user.load_world_path``);
-    a user world is fixed, so it takes no scenario and ignores ``seed``."""
+    """A built-in world by name, or a user world by path: a site file, an SDF world, a mesh
+    with its labels (see ``worlds.user.load_world_path``); a user world is fixed, so it takes
+    no scenario and ignores ``seed``."""
     if name_or_path in WORLDS:
         return generate_world(name_or_path, scenario, seed)
     if not is_world_path(name_or_path):
@@ -144,4 +151,5 @@ def open_world(name_or_path: str, scenario: str | None = None, seed: int = 0) ->
 def is_world_path(text: str) -> bool:
     """Whether ``text`` names a file or folder rather than a built-in world."""
     suffix = Path(text).suffix.lower()
-    return os.sep in text or suffix in MESH_SUFFIXES + LABELS_SUFFIXES or Path(text).exists()
+    suffixes = MESH_SUFFIXES + LABELS_SUFFIXES + SDF_SUFFIXES + OCTOMAP_SUFFIXES
+    return os.sep in text or suffix in suffixes or Path(text).exists()

@@ -7,19 +7,21 @@ A labels file (JSON or YAML) maps faces of the mesh to instance, class and part:
     name: parking-lot
     scale: 0.01            # mesh units to metres (optional, default 1)
     up: z                  # "y" turns a Y-up mesh (glTF, many OBJ exports) Z-up
-    ground: {margin: 10}   # optional: add a ground plane under the mesh, 10 m around it
+    ground: {margin: 10}   # optional: a ground plane under the mesh, 10 m around it (z: height)
     start: {position: [0, -6, 0], yaw: 1.57}
     labels:
-      - {groups: ["Hybrid body"], instance: car-1, class: car, part: body}
+      - {groups: [Hybrid], instance: car-1, class: car, part: body}
       - {groups: [Wheels_Rear], box: [[-2, 0, -1], [0, 9, 2]], instance: car-1,
          class: car, part: back-left-wheel}
       - {faces: [[0, 500]], class: wall}
 
-Each entry selects faces by mesh ``groups`` (OBJ ``g``/``o`` names, glTF node or mesh names),
-by half-open ``faces`` index ranges, or all faces when neither is given; an optional ``box``
-(world coordinates, after scale and up) keeps only faces whose centroid lies inside it. Later
-entries override earlier ones. Faces no entry selects are ``background``. An entry without
-``instance`` labels background geometry (``class: ground`` marks the floor).
+Each entry selects faces by mesh ``groups`` (OBJ ``g``/``o`` names, glTF node or mesh names,
+COLLADA geometry or node names), by half-open ``faces`` index ranges, or all faces when neither
+is given; an optional ``box`` (world coordinates, after scale and up) keeps only faces whose
+centroid lies inside it. Later entries override earlier ones. Faces no entry selects are
+``background``. An entry without ``instance`` labels background geometry (``class: ground``
+marks the floor). Several meshes, each placed by position and yaw, make a site file
+(``worlds.site``).
 
 :func:`save_world` writes ``world.ply`` and ``labels.json`` in this format (face ranges), so any
 world, generated or loaded, round-trips through :func:`load_world`.
@@ -34,60 +36,32 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-import trimesh
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.core.io import atomic_write_bytes, read_json, read_yaml, write_versioned_json
 from seminspect.worlds.builder import WorldBuilder
-from seminspect.worlds.collision import check_grid_sizes
+from seminspect.worlds.labelling import (
+    SIZE_FIX,
+    Entry,
+    Ground,
+    Start,
+    add_labelled,
+    assign_labels,
+    finish_world,
+)
+from seminspect.worlds.meshes import MESH_SUFFIXES, read_mesh
+from seminspect.worlds.sdf import SDF_SUFFIXES, load_sdf
 from seminspect.worlds.shapes import pose_matrix
-from seminspect.worlds.world import BACKGROUND, World
+from seminspect.worlds.site import is_site_file, load_site
+from seminspect.worlds.world import World
 
 LABELS_FORMAT = "seminspect-world-labels"
 LABELS_VERSION = 1
-MESH_SUFFIXES = (".obj", ".ply", ".glb", ".gltf", ".stl", ".off")
 LABELS_SUFFIXES = (".json", ".yaml", ".yml")
-#: Refuse meshes above this size before parsing them.
-MAX_MESH_BYTES = 512 << 20
-#: How to shrink a world too large for its collision grids.
-_SIZE_FIX = (
-    "is its scale right? 'scale: {scale:g}' turns mesh units into metres: use a smaller scale "
-    "or tighter 'bounds:'"
-)
-
-
-class _Entry(BaseModel):
-    model_config = ConfigDict(extra="forbid", populate_by_name=True)
-
-    groups: list[str] | None = None
-    faces: list[tuple[int, int]] | None = None
-    box: tuple[tuple[float, float, float], tuple[float, float, float]] | None = None
-    instance: str | None = None
-    class_name: str = Field(BACKGROUND, alias="class")
-    part: str = ""
-
-    @field_validator("faces")
-    @classmethod
-    def _ranges(cls, ranges: list[tuple[int, int]] | None) -> list[tuple[int, int]] | None:
-        for start, stop in ranges or []:
-            if not 0 <= start <= stop:
-                raise ValueError(f"face range [{start}, {stop}] must satisfy 0 <= start <= stop")
-        return ranges
-
-
-class _Start(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-    position: tuple[float, float, float]
-    yaw: float = 0.0
-
-
-class _Ground(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-    margin: float = Field(10.0, ge=0, le=1e4)
+#: OctoMap files: maps, refused as worlds with a pointer to where they are used.
+OCTOMAP_SUFFIXES = (".bt", ".ot")
 
 
 class _Labels(BaseModel):
@@ -98,11 +72,11 @@ class _Labels(BaseModel):
     name: str = "user"
     scale: float = Field(1.0, gt=0)
     up: Literal["z", "y"] = "z"
-    ground: _Ground | None = None
+    ground: Ground | None = None
     bounds: tuple[tuple[float, float, float], tuple[float, float, float]] | None = None
-    start: _Start | None = None
+    start: Start | None = None
     seed: int = Field(0, ge=0)
-    labels: list[_Entry] = []
+    labels: list[Entry] = []
     metadata: dict[str, Any] = {}
 
 
@@ -120,160 +94,6 @@ def _read_labels(path: Path) -> _Labels:
         raise FileFormatError(f"{path}: {where}: {first['msg']}") from None
 
 
-def _obj_mesh(path: Path) -> tuple[NDArray, NDArray, list[str], NDArray]:
-    """Vertices, triangles, group names and the group of each triangle of an OBJ file.
-
-    OBJ ``g``/``o`` names are read straight from the text (trimesh renames groups); polygons are
-    split into fans of triangles.
-    """
-    vertices: list[list[float]] = []
-    faces: list[tuple[int, int, int]] = []
-    face_group: list[int] = []
-    groups = ["default"]
-    current = 0
-    try:
-        lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
-    except OSError as exc:
-        raise FileFormatError(f"{path}: cannot read ({exc.strerror})") from None
-    for number, line in enumerate(lines, start=1):
-        fields = line.split()
-        if not fields:
-            continue
-        try:
-            if fields[0] == "v":
-                vertices.append([float(x) for x in fields[1:4]])
-                if len(vertices[-1]) != 3:
-                    raise ValueError("a vertex needs three coordinates")
-            elif fields[0] in ("g", "o"):
-                name = " ".join(fields[1:]) or "default"
-                if name not in groups:
-                    groups.append(name)
-                current = groups.index(name)
-            elif fields[0] == "f":
-                corners = [_obj_index(token, len(vertices)) for token in fields[1:]]
-                if len(corners) < 3:
-                    raise ValueError("a face needs at least three vertices")
-                for k in range(1, len(corners) - 1):
-                    faces.append((corners[0], corners[k], corners[k + 1]))
-                    face_group.append(current)
-        except ValueError as exc:
-            raise FileFormatError(f"{path}:{number}: {exc}") from None
-    if not faces:
-        raise FileFormatError(f"{path}: no faces found")
-    return np.array(vertices), np.array(faces), groups, np.array(face_group)
-
-
-def _obj_index(token: str, count: int) -> int:
-    index = int(token.split("/", 1)[0])
-    resolved = index - 1 if index > 0 else count + index
-    if not 0 <= resolved < count:
-        raise ValueError(f"vertex index {index} refers to none of the {count} vertices so far")
-    return resolved
-
-
-def _trimesh_mesh(path: Path) -> tuple[NDArray, NDArray, list[str], NDArray]:
-    """Vertices, triangles and per-triangle group for formats trimesh reads (glTF nodes)."""
-    try:
-        scene = trimesh.load(str(path), force="scene", process=False)
-    except Exception as exc:  # trimesh raises many types for broken files
-        raise FileFormatError(f"{path}: cannot read mesh ({type(exc).__name__}: {exc})") from None
-    vertices, faces, group_of, groups = [], [], [], []
-    offset = 0
-    assert isinstance(scene, trimesh.Scene), "force='scene' loads a scene"
-    for node in scene.graph.nodes_geometry:
-        matrix, geometry_name = scene.graph[node]
-        geometry = scene.geometry[geometry_name]
-        if not isinstance(geometry, trimesh.Trimesh) or len(geometry.faces) == 0:
-            continue
-        groups.append(str(node))
-        vertices.append(trimesh.transform_points(geometry.vertices, matrix))
-        faces.append(np.asarray(geometry.faces) + offset)
-        group_of.append(np.full(len(geometry.faces), len(groups) - 1))
-        offset += len(geometry.vertices)
-        if geometry_name != node:
-            groups.append(str(geometry_name))  # the mesh's own name selects the same faces
-            group_of[-1] = np.stack([group_of[-1], np.full(len(geometry.faces), len(groups) - 1)])
-    if not faces:
-        raise FileFormatError(f"{path}: no triangles found")
-    return _flatten_groups(vertices, faces, groups, group_of)
-
-
-def _flatten_groups(
-    vertices, faces, groups, group_of
-) -> tuple[NDArray, NDArray, list[str], NDArray]:
-    """Per-face group membership as a (G, F) boolean table (a face may be in two names)."""
-    total = sum(len(f) for f in faces)
-    member = np.zeros((len(groups), total), dtype=bool)
-    start = 0
-    for f, ids in zip(faces, group_of, strict=True):
-        for row in np.atleast_2d(ids):
-            member[row, np.arange(start, start + len(f))] = True
-        start += len(f)
-    return np.vstack(vertices), np.vstack(faces), groups, member
-
-
-def _read_mesh(path: Path) -> tuple[NDArray, NDArray, list[str], NDArray]:
-    """Vertices, faces, group names and a (G, F) membership table."""
-    if not path.is_file():
-        raise FileFormatError(f"{path}: no such file")
-    suffix = path.suffix.lower()
-    if suffix not in MESH_SUFFIXES:
-        raise FileFormatError(
-            f"{path}: unsupported mesh type {suffix!r}; use {', '.join(MESH_SUFFIXES)}"
-        )
-    if path.stat().st_size > MAX_MESH_BYTES:
-        raise FileFormatError(f"{path}: larger than {MAX_MESH_BYTES >> 20} MB")
-    if suffix == ".obj":
-        vertices, faces, groups, face_group = _obj_mesh(path)
-        member = face_group[None, :] == np.arange(len(groups))[:, None]
-    else:
-        vertices, faces, groups, member = _trimesh_mesh(path)
-    if not np.all(np.isfinite(vertices)):
-        raise FileFormatError(f"{path}: vertices contain NaN or infinity")
-    return vertices.astype(np.float64), faces.astype(np.int64), groups, member
-
-
-# --------------------------------------------------------------------------------- labelling
-def _select(entry: _Entry, groups: list[str], member: NDArray, centroids: NDArray, where: str):
-    count = member.shape[1]
-    if entry.groups is None and entry.faces is None:
-        chosen = np.ones(count, dtype=bool)
-    else:
-        chosen = np.zeros(count, dtype=bool)
-    for group in entry.groups or []:
-        if group not in groups:
-            known = ", ".join(repr(g) for g in groups[:12])
-            raise FileFormatError(f"{where}: no mesh group {group!r}; the mesh has {known}")
-        chosen |= member[groups.index(group)]
-    for start, stop in entry.faces or []:
-        if stop > count:
-            raise FileFormatError(
-                f"{where}: face range [{start}, {stop}) exceeds the {count} faces"
-            )
-        chosen[start:stop] = True
-    if entry.box is not None:
-        lo, hi = np.asarray(entry.box[0]), np.asarray(entry.box[1])
-        chosen &= np.all((centroids >= lo) & (centroids <= hi), axis=1)
-    return chosen
-
-
-def _assign(labels: _Labels, groups, member, centroids, source: Path):
-    """Per-face (instance name, class, part) after applying every entry in order."""
-    count = member.shape[1]
-    instance = np.full(count, "", dtype=object)
-    classes = np.full(count, BACKGROUND, dtype=object)
-    parts = np.full(count, "", dtype=object)
-    for index, entry in enumerate(labels.labels):
-        where = f"{source}: labels[{index}]"
-        chosen = _select(entry, groups, member, centroids, where)
-        if not chosen.any():
-            raise FileFormatError(f"{where}: selects no faces")
-        instance[chosen] = entry.instance or ""
-        classes[chosen] = entry.class_name
-        parts[chosen] = entry.part
-    return instance, classes, parts
-
-
 def _transform(labels: _Labels, vertices: NDArray) -> NDArray:
     points = vertices * labels.scale
     if labels.up == "y":
@@ -282,39 +102,48 @@ def _transform(labels: _Labels, vertices: NDArray) -> NDArray:
 
 
 def load_world(mesh_path: str | os.PathLike[str], labels_path: str | os.PathLike[str]) -> World:
-    """Load a user's mesh (OBJ, PLY, GLB/glTF, STL, OFF) with its labels file."""
+    """Load a user's mesh (OBJ, PLY, GLB/glTF, STL, OFF, DAE) with its labels file."""
     source = Path(labels_path)
     labels = _read_labels(source)
-    raw, faces, groups, member = _read_mesh(Path(mesh_path))
-    if faces.min() < 0 or faces.max() >= len(raw):
-        raise FileFormatError(f"{mesh_path}: faces refer to missing vertices")
+    raw, faces, groups, member = read_mesh(Path(mesh_path))
     vertices = _transform(labels, raw)
     centroids = vertices[faces].mean(axis=1)
     builder = WorldBuilder(labels.name, labels.seed)
     try:
-        _add_labelled(builder, vertices, faces, _assign(labels, groups, member, centroids, source))
-        lo, hi = vertices.min(axis=0), vertices.max(axis=0)
-        if labels.ground is not None:
-            margin = np.array([labels.ground.margin, labels.ground.margin, 0.0])
-            builder.add_ground(lo[:2] - margin[:2], hi[:2] + margin[:2], float(lo[2]))
-            lo, hi = lo - margin, hi + margin
-        bounds = np.array(labels.bounds or [lo, hi + np.array([0.0, 0.0, 2.0])])
-        check_grid_sizes(bounds, fix=_SIZE_FIX.format(scale=labels.scale))
-        start = labels.start or _Start(position=(bounds[0, 0] + 1.0, bounds[0, 1] + 1.0, lo[2]))
-        # the ground is the mesh's lowest point unless the file says otherwise (a saved world)
-        metadata = {"ground_z": float(lo[2]), **labels.metadata, "source": str(mesh_path)}
-        return builder.build(bounds, start.position, start.yaw, metadata)
+        where = f"{source}: labels"
+        add_labelled(
+            builder, vertices, faces, assign_labels(labels.labels, groups, member, centroids, where)
+        )
+        return finish_world(
+            builder,
+            vertices,
+            ground=labels.ground,
+            bounds=labels.bounds,
+            start=labels.start,
+            metadata={**labels.metadata, "source": str(mesh_path)},
+            fix=SIZE_FIX.format(scale=labels.scale),
+        )
     except InvalidInputError as exc:
         raise FileFormatError(f"{source}: {exc}") from None
 
 
 def load_world_path(path: str | os.PathLike[str]) -> World:
-    """A user world named by one path: a directory holding a labels file and one mesh (what
+    """A user world named by one path: a site file (``worlds.site``), a Gazebo SDF world or
+    model (``worlds.sdf``), a directory holding a labels file and one mesh (what
     :func:`save_world` writes), a labels file with one mesh beside it, or a mesh with one
     labels file beside it."""
     source = Path(path)
+    if source.suffix.lower() in OCTOMAP_SUFFIXES:
+        raise FileFormatError(
+            f"{source}: an OctoMap is a map, not a world; use it as a prior with "
+            f"'seminspect routine inspect --prior {source}' or plan on it with 'seminspect plan'"
+        )
     if not source.exists():
         raise FileFormatError(f"{source}: no such world file or directory")
+    if source.is_file() and source.suffix.lower() in SDF_SUFFIXES:
+        return load_sdf(source)
+    if is_site_file(source):
+        return load_site(source)
     folder = source if source.is_dir() else source.parent
     meshes = [source] if _is_mesh(source) else _beside(folder, _is_mesh, "mesh", source)
     labels = [source] if _is_labels(source) else _beside(folder, _is_labels, "labels file", source)
@@ -339,21 +168,6 @@ def _beside(folder: Path, wanted: Callable[[Path], bool], kind: str, given: Path
             "see 'seminspect world export' for the layout"
         )
     return found
-
-
-def _add_labelled(builder: WorldBuilder, vertices, faces, labels: tuple[NDArray, ...]) -> None:
-    """Add every face in file order; objects are numbered in order of their first face."""
-    instance, classes, parts = labels
-    ids: dict[str, int] = {"": 0}
-    for name in dict.fromkeys(instance.tolist()):
-        if not name:
-            continue
-        found = sorted(set(classes[instance == name].tolist()))
-        if len(found) != 1:
-            raise InvalidInputError(f"object {name!r} is labelled with classes {found}")
-        ids[name] = builder.new_instance(found[0], name)
-    numbers = np.array([ids[name] for name in instance.tolist()], dtype=np.int32)
-    builder.add_faces(vertices, faces, classes.tolist(), parts.tolist(), numbers)
 
 
 # --------------------------------------------------------------------------------- writing

@@ -20,6 +20,7 @@ the file holds.
 from __future__ import annotations
 
 import os
+from importlib.resources import files
 from pathlib import Path
 from typing import Annotated, Any, Final, Literal
 
@@ -234,6 +235,12 @@ def save_graph(graph: LayeredSemanticGraph, path: str | os.PathLike[str]) -> Pat
 
 
 # ---------------------------------------------------------------------- loading
+def example_graph_path() -> Path:
+    """The small graph shipped with seminspect (five inspected vehicles; ``example`` in the
+    ``seminspect graph`` commands)."""
+    return Path(str(files("seminspect") / "data" / "example_graph.json"))
+
+
 def load_graph(path: str | os.PathLike[str]) -> LayeredSemanticGraph:
     """Read a graph written by :func:`save_graph`; any defect raises :class:`FileFormatError`.
 

@@ -1,4 +1,5 @@
-"""Views of a 3DLSG as networkx graphs: the whole unified graph, or its traversable part."""
+"""Views of a 3DLSG as networkx graphs: the whole unified graph, one layer, or the traversable
+part."""
 
 from __future__ import annotations
 
@@ -9,12 +10,15 @@ from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.model import (
     EdgeKind,
     FeatureNode,
+    Layer,
     LevelNode,
     Node,
     PoseNode,
     RobotNode,
     TargetNode,
 )
+from seminspect.graphs.lsg.structure import GraphStructure
+from seminspect.graphs.lsg.tables import Row, edge_row, node_row
 
 
 def node_attributes(node: Node) -> dict[str, str | float | int | bool]:
@@ -55,6 +59,25 @@ def to_networkx(graph: LayeredSemanticGraph) -> nx.Graph:
     for edge in graph.edges():
         result.add_edge(edge.u, edge.v, kind=edge.kind.value, weight=float(edge.weight))
     return result
+
+
+def layer_networkx(graph: GraphStructure, layer: Layer) -> nx.Graph:
+    """One layer as the union of its local graphs, parents included (the Pose layer holds the
+    levels and their poses), so it has the nodes and edges ``graph.population()`` counts for
+    that layer. Node attributes are the node's table row (:mod:`.tables`, ``layer`` added);
+    edge attributes are ``kind``, ``weight`` and ``via_points``."""
+    result = nx.Graph(layer=layer.value)
+    for local in graph.local_graphs(layer):
+        for node in local.nodes.values():
+            result.add_node(node.id, layer=node.layer.value, **_without_id(node_row(node)))
+        for edge in local.edges.values():
+            row = edge_row(edge)
+            result.add_edge(row.pop("u"), row.pop("v"), **row)
+    return result
+
+
+def _without_id(row: Row) -> Row:
+    return {key: value for key, value in row.items() if key != "id"}
 
 
 def traversable_networkx(graph: LayeredSemanticGraph) -> nx.Graph:

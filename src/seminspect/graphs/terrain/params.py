@@ -4,10 +4,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from dataclasses import dataclass, field
 
+import numpy as np
+from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from seminspect.core.validation import build
+from seminspect.geometry.nearest import median_spacing
 
 
 class TerrainGraphParams(BaseModel):
@@ -36,6 +40,9 @@ class TerrainGraphParams(BaseModel):
     region_delta: float = Field(
         0.02, ge=0, description="stop merging when one merge loses this share of I(X;Y)"
     )
+    region_max_extent: float = Field(
+        120.0, gt=0, description="no region spans more than this (x-y box diagonal)"
+    )
 
     @model_validator(mode="after")
     def _consistent(self) -> TerrainGraphParams:
@@ -50,3 +57,97 @@ class TerrainGraphParams(BaseModel):
 def make_terrain_params(values: Mapping[str, float | int]) -> TerrainGraphParams:
     """Validate raw values, with one readable error line."""
     return build(TerrainGraphParams, values, "terrain graph parameter")
+
+
+#: Above this median spacing of the terrain points (metres) the defaults, tuned for ground-robot
+#: LiDAR (SemanticKITTI's fused terrain 0.025 m, the tests' grid 0.3 m), leave most 0.5 m cells
+#: empty: at Autzen's airborne 0.59 m, 57 % of the cells of the ground's footprint are.
+DENSE_SPACING = 0.4
+#: A derived cell holds about nine points of a regular pattern of the spacing (three a side);
+#: at Autzen 3 x 0.59 m = 1.8 m cells fill 79 % of the footprint, which the closing then closes.
+CELLS_PER_SPACING = 3.0
+#: Objects: DBSCAN's radius must reach past the nearest neighbours of a surface at the spacing.
+EPS_PER_SPACING = 2.5
+#: Lengths that guard against digitisation noise keep their size in cells when the cell grows.
+_GRID_LENGTHS = ("prune_length", "split_deviation")
+
+
+@dataclass(frozen=True)
+class ParamsChoice:
+    """The parameters a build uses, and how the cloud's spacing chose them.
+
+    Attributes:
+        params: the parameters to build with.
+        spacing: median x-y nearest-neighbour distance of the terrain points, metres (NaN
+            when there are fewer than two).
+        derived: the values derived from the spacing (empty when the defaults fit the cloud);
+            values the caller set are never derived.
+    """
+
+    params: TerrainGraphParams
+    spacing: float
+    derived: dict[str, float] = field(default_factory=dict)
+
+    def describe(self) -> str:
+        """One line for the user: the spacing and what it changed."""
+        if not math.isfinite(self.spacing):
+            return "terrain point spacing: too few terrain points to measure"
+        head = f"terrain point spacing {self.spacing:.3g} m"
+        if not self.derived:
+            return f"{head}: default parameters"
+        values = ", ".join(f"{name} {value:g}" for name, value in self.derived.items())
+        return f"{head} (sparser than {DENSE_SPACING} m): derived {values}"
+
+
+def _nice(value: float) -> float:
+    """``value`` rounded up to two significant digits (1.776 -> 1.8, 0.317 -> 0.32)."""
+    step = 10.0 ** (math.floor(math.log10(value)) - 1)
+    return round(math.ceil(value / step - 1e-9) * step, 10)
+
+
+def _derive(spacing: float, user: TerrainGraphParams, fixed: set[str]) -> dict[str, float]:
+    """Values for a cloud sparser than :data:`DENSE_SPACING`, leaving ``fixed`` names alone."""
+    defaults = TerrainGraphParams()
+    cell = user.cell_size if "cell_size" in fixed else _nice(CELLS_PER_SPACING * spacing)
+    scale = cell / defaults.cell_size
+    eps = user.object_eps if "object_eps" in fixed else _nice(EPS_PER_SPACING * spacing)
+    values = {
+        "cell_size": cell,
+        "min_patch_area": _nice(defaults.min_patch_area * scale**2),
+        **{name: _nice(getattr(defaults, name) * scale) for name in _GRID_LENGTHS},
+        "object_eps": max(eps, defaults.object_eps),
+    }
+    # a third of the radius (the defaults use a fifth): at this density such a voxel holds about
+    # one point anyway, and larger voxels shorten DBSCAN's neighbour lists, its cost (1 M points)
+    values["object_voxel"] = _nice(max(defaults.object_voxel, values["object_eps"] / 3.0))
+    if values["object_voxel"] >= values["object_eps"]:  # the user's eps is below the spacing
+        values["object_voxel"] = _nice(values["object_eps"] / 5.0)
+    return {
+        name: value
+        for name, value in values.items()
+        if name not in fixed and value != getattr(defaults, name)
+    }
+
+
+def params_for_cloud(
+    terrain_points: NDArray[np.floating],
+    params: TerrainGraphParams | Mapping[str, float | int] | None = None,
+    *,
+    seed: int = 0,
+) -> ParamsChoice:
+    """Parameters fitted to the density of a cloud's terrain points.
+
+    ``params`` holds what the user chose: a mapping of names, or a :class:`TerrainGraphParams`
+    whose explicitly set fields count as chosen (``make_terrain_params`` sets only the given
+    ones). Chosen values always win. The rest keep their defaults unless the terrain's median
+    spacing exceeds :data:`DENSE_SPACING`; then the grid is three spacings a cell, the lengths
+    measured in cells keep their size in cells and DBSCAN's radius and voxel follow the spacing.
+    """
+    user = params if isinstance(params, TerrainGraphParams) else make_terrain_params(params or {})
+    spacing = median_spacing(terrain_points, planar=True, seed=seed)
+    if not (math.isfinite(spacing) and spacing > DENSE_SPACING):
+        return ParamsChoice(user, spacing)
+    fixed = set(user.model_fields_set)
+    derived = _derive(spacing, user, fixed)
+    chosen = make_terrain_params({**user.model_dump(include=fixed), **derived})
+    return ParamsChoice(chosen, spacing, derived)

@@ -17,6 +17,7 @@ spirit (see ``docs/terrain.md``):
 from __future__ import annotations
 
 import heapq
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 
@@ -24,6 +25,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 _TINY = 1e-12
+#: A merge losing at most this many bits loses nothing: identical task mixes cost a few 1e-17
+#: of rounding, which must not stop them where I(X;Y) = 0 and the budget is 0 (one task only).
+FREE_MERGE = 1e-12
 
 
 @dataclass(frozen=True)
@@ -71,67 +75,125 @@ def mutual_information(px: NDArray[np.float64], py_x: NDArray[np.float64]) -> fl
     """``I(X;Y)`` in bits for ``p(x)`` and rows ``p(y|x)``."""
     py = px @ py_x
     ratio = np.where(py_x > 0, py_x / np.where(py > 0, py, 1.0), 1.0)
-    return float(np.sum(px[:, None] * py_x * np.log2(ratio)))
+    # rounding leaves a few -1e-15 where every row is the same; information is never negative
+    return max(float(np.sum(px[:, None] * py_x * np.log2(ratio))), 0.0)
 
 
 def merge_cost(pi: float, pj: float, yi: NDArray[np.float64], yj: NDArray[np.float64]) -> float:
-    """Information lost by merging two clusters: ``(p_i + p_j) · JS_π``."""
+    """Information lost by merging two clusters: ``(p_i + p_j) · JS_π`` (Slonim and Tishby)."""
     total = pi + pj
     wi, wj = pi / total, pj / total
     js = _entropy(wi * yi + wj * yj) - wi * _entropy(yi) - wj * _entropy(yj)
     return total * max(js, 0.0)
 
 
-def agglomerate(
-    py_x: NDArray[np.float64], links: Iterable[tuple[int, int]], delta: float
-) -> RegionClusters:
-    """Greedy connectivity-constrained AIB over primitives with rows ``p(y|x)``."""
-    n = py_x.shape[0]
-    px = np.full(n, 1.0 / n) if n else np.zeros(0)
-    information = mutual_information(px, py_x) if n else 0.0
-    weight = {i: float(px[i]) for i in range(n)}
-    mix = {i: py_x[i].copy() for i in range(n)}
-    parent = list(range(n))
+@dataclass
+class _Clusters:
+    """The bottleneck's working state: each live cluster's weight, task mix and x-y box."""
+
+    weight: dict[int, float]
+    mix: dict[int, NDArray[np.float64]]
+    low: dict[int, NDArray[np.float64]]
+    high: dict[int, NDArray[np.float64]]
+    version: dict[int, int]
+    entropy: dict[int, float]  # H(Y|c) of each cluster, kept to price merges three times faster
+
+    def entry(self, a: int, b: int) -> tuple[float, float, int, int, int, int]:
+        """Heap key of merging ``a`` and ``b``: loss (free below the tolerance), then size."""
+        lo, hi = min(a, b), max(a, b)
+        total = self.weight[lo] + self.weight[hi]
+        wi, wj = self.weight[lo] / total, self.weight[hi] / total
+        mixed = _entropy(wi * self.mix[lo] + wj * self.mix[hi])
+        cost = total * max(mixed - wi * self.entropy[lo] - wj * self.entropy[hi], 0.0)
+        free = 0.0 if cost <= FREE_MERGE else cost
+        size = self.weight[lo] + self.weight[hi]
+        return (free, size, lo, hi, self.version[lo], self.version[hi])
+
+    def extent(self, a: int, b: int) -> float:
+        """Diagonal of the x-y box of the two clusters' members together, metres."""
+        span = np.maximum(self.high[a], self.high[b]) - np.minimum(self.low[a], self.low[b])
+        return float(np.hypot(span[0], span[1]))
+
+    def merge(self, a: int, b: int) -> None:
+        total = self.weight[a] + self.weight[b]
+        self.mix[a] = (self.weight[a] * self.mix[a] + self.weight[b] * self.mix[b]) / total
+        self.weight[a] = total
+        self.low[a] = np.minimum(self.low[a], self.low[b])
+        self.high[a] = np.maximum(self.high[a], self.high[b])
+        self.entropy[a] = _entropy(self.mix[a])
+        del self.weight[b], self.mix[b], self.low[b], self.high[b], self.version[b]
+        del self.entropy[b]
+        self.version[a] += 1
+
+
+def _neighbours(n: int, links: Iterable[tuple[int, int]]) -> dict[int, set[int]]:
     neighbours: dict[int, set[int]] = {i: set() for i in range(n)}
     for a, b in links:
         if a != b:
             neighbours[a].add(b)
             neighbours[b].add(a)
-    version = dict.fromkeys(range(n), 0)
-    heap = []
-    for a in range(n):
-        for b in neighbours[a]:
-            if a < b:
-                heap.append((merge_cost(weight[a], weight[b], mix[a], mix[b]), a, b, 0, 0))
+    return neighbours
+
+
+def agglomerate(
+    py_x: NDArray[np.float64],
+    links: Iterable[tuple[int, int]],
+    delta: float,
+    positions: NDArray[np.floating] | None = None,
+    max_extent: float = math.inf,
+) -> RegionClusters:
+    """Greedy connectivity-constrained AIB over primitives with rows ``p(y|x)``.
+
+    With ``positions`` (``(n, 2+)``, x-y used), a merge whose members would span more than
+    ``max_extent`` metres (their x-y box's diagonal) is skipped, so a region is spatially
+    bounded even where every primitive serves the same task and the bottleneck sees nothing to
+    keep apart. Merges that lose no information (at most :data:`FREE_MERGE` bits) go first and
+    smallest first, so such regions grow evenly rather than as one chain.
+    """
+    n = py_x.shape[0]
+    px = np.full(n, 1.0 / n) if n else np.zeros(0)
+    information = mutual_information(px, py_x) if n else 0.0
+    xy = np.zeros((n, 2)) if positions is None else np.asarray(positions, np.float64)[:, :2]
+    state = _Clusters(
+        weight={i: float(px[i]) for i in range(n)},
+        mix={i: py_x[i].copy() for i in range(n)},
+        low={i: xy[i].copy() for i in range(n)},
+        high={i: xy[i].copy() for i in range(n)},
+        version=dict.fromkeys(range(n), 0),
+        entropy={i: _entropy(py_x[i]) for i in range(n)},
+    )
+    parent = list(range(n))
+    neighbours = _neighbours(n, links)
+    heap = [state.entry(a, b) for a in range(n) for b in neighbours[a] if a < b]
     heapq.heapify(heap)
     budget = delta * information
     while heap:
-        cost, a, b, va, vb = heapq.heappop(heap)
-        if version.get(a) != va or version.get(b) != vb:
+        cost, _, a, b, va, vb = heapq.heappop(heap)
+        if state.version.get(a) != va or state.version.get(b) != vb:
             continue  # one side has merged since this entry was pushed
         if cost > budget:
             break
-        total = weight[a] + weight[b]
-        mix[a] = (weight[a] * mix[a] + weight[b] * mix[b]) / total
-        weight[a] = total
+        if state.extent(a, b) > max_extent:
+            continue  # boxes only grow: this pair stays too large
+        state.merge(a, b)
         parent[b] = a
         for other in neighbours.pop(b) - {a}:
             neighbours[other].discard(b)
             neighbours[other].add(a)
             neighbours[a].add(other)
         neighbours[a].discard(b)
-        del weight[b], mix[b], version[b]
-        version[a] += 1
         for other in neighbours[a]:
-            lo, hi = min(a, other), max(a, other)
-            entry = merge_cost(weight[lo], weight[hi], mix[lo], mix[hi])
-            heapq.heappush(heap, (entry, lo, hi, version[lo], version[hi]))
-    roots = [_root(parent, i) for i in range(n)]
+            heapq.heappush(heap, state.entry(a, other))
+    return _result(parent, state, information, py_x.shape[1])
+
+
+def _result(parent: list[int], state: _Clusters, information: float, tasks: int) -> RegionClusters:
+    roots = [_root(parent, i) for i in range(len(parent))]
     order = {root: k for k, root in enumerate(sorted(set(roots)))}
     assignment = np.array([order[r] for r in roots], dtype=np.int64)
-    distributions = np.array([mix[r] for r in sorted(order)]).reshape(len(order), py_x.shape[1])
-    cluster_weight = np.array([weight[r] for r in sorted(order)])
-    retained = mutual_information(cluster_weight, distributions) if n else 0.0
+    distributions = np.array([state.mix[r] for r in sorted(order)]).reshape(len(order), tasks)
+    cluster_weight = np.array([state.weight[r] for r in sorted(order)])
+    retained = mutual_information(cluster_weight, distributions) if parent else 0.0
     return RegionClusters(assignment, distributions, information, retained)
 
 

@@ -20,8 +20,8 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from seminspect.graphs.terrain.objects import ObjectCluster, extract_objects
-from seminspect.graphs.terrain.params import TerrainGraphParams
-from seminspect.graphs.terrain.places import PlaceLayer, build_places
+from seminspect.graphs.terrain.params import ParamsChoice, TerrainGraphParams, params_for_cloud
+from seminspect.graphs.terrain.places import PlaceLayer, build_places, warn_if_fragmented
 from seminspect.graphs.terrain.prompting import TaskPoints, TaskPrompts, embed_prompts, task_points
 from seminspect.graphs.terrain.regions import RegionClusters, agglomerate, task_distributions
 from seminspect.mapping.semantic_cloud import SemanticCloud
@@ -76,6 +76,7 @@ class TerrainBuild:
     regions: RegionClusters
     cloud_classes: NDArray[np.int64]
     timings: dict[str, float] = field(default_factory=dict)
+    choice: ParamsChoice | None = None
 
 
 def _timed(timings: dict[str, float], name: str, on_stage: Callable[[str], None] | None):
@@ -206,20 +207,25 @@ def build_terrain_graph(
 ) -> TerrainBuild:
     """Phase 2 of 001 (Sec III-B): the task-driven graph of a metric-semantic cloud.
 
-    ``calibration`` defaults to the thresholds registered for the cloud's encoder.
+    ``calibration`` defaults to the thresholds registered for the cloud's encoder. Parameters
+    that ``params`` does not set explicitly follow the terrain points' spacing
+    (:func:`~seminspect.graphs.terrain.params.params_for_cloud`); the build's ``choice`` says
+    what was derived.
     """
-    params = params or TerrainGraphParams()
     calibration = calibration or calibration_for(cloud.encoder)
     timings: dict[str, float] = {}
     with _timed(timings, "prompts", on_stage):
         embeddings = embed_prompts(encoder, prompts.all, cloud.dim)
         layer, classes = task_points(cloud, prompts, embeddings, calibration)
+        choice = params_for_cloud(layer.points[layer.classes < len(prompts.terrain)], params)
+        params = choice.params
     with _timed(timings, "objects", on_stage):
         objects = extract_objects(
             layer, params.object_eps, params.object_min_points, params.object_voxel
         )
     with _timed(timings, "places", on_stage):
         places = build_places(layer, params)
+        warn_if_fragmented(places, choice.spacing)
         anchors = _closest_places(objects, places)
     with _timed(timings, "regions", on_stage):
         py_x = task_distributions(
@@ -230,10 +236,17 @@ def build_terrain_graph(
         n_places = len(places.places)
         links = [(a, b) for a, b, _, _ in places.edges]
         links += [(n_places + k, p) for k, p in enumerate(anchors) if p is not None]
-        regions = agglomerate(py_x, links, params.region_delta)
+        positions = [p.position for p in places.places] + [o.centroid for o in objects]
+        regions = agglomerate(
+            py_x,
+            links,
+            params.region_delta,
+            np.array(positions).reshape(len(positions), 3),
+            params.region_max_extent,
+        )
     with _timed(timings, "assemble", on_stage):
         graph = _assemble(prompts, places, objects, anchors, regions)
     scene = TerrainSceneGraph(
         graph, prompts, cloud.encoder, calibration, params, layer.counts(), layer
     )
-    return TerrainBuild(scene, places, objects, regions, classes, timings)
+    return TerrainBuild(scene, places, objects, regions, classes, timings, choice)

@@ -11,6 +11,7 @@ is never lost by coarsening.
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 from dataclasses import dataclass
@@ -58,12 +59,24 @@ def _check_header(source: Path) -> None:
 def read_octomap_leaves(path: str | os.PathLike[str]) -> OctreeLeaves:
     """Decode the leaves of a ``.bt`` file with ``pyoctomap``.
 
+    The last files decoded are kept (keyed by path, size and modification time, their arrays
+    read-only): a routine site built from a map reads it for the world and for ``M_H``.
+
     Raises:
         FileFormatError: missing, malformed or truncated file.
         SeminspectError: the ``octomap`` extra is not installed.
     """
     source = Path(path)
     _check_header(source)
+    stat = source.stat()
+    return _decoded(str(source.resolve()), stat.st_size, stat.st_mtime_ns, str(source))
+
+
+@functools.lru_cache(maxsize=2)
+def _decoded(resolved: str, size: int, mtime_ns: int, shown: str) -> OctreeLeaves:
+    """The leaves of one version of a file (``size`` and ``mtime_ns`` tell versions apart)."""
+    del size, mtime_ns  # only part of the cache key
+    source = Path(shown)
     try:
         import pyoctomap  # noqa: PLC0415 - an optional extra
     except ImportError:
@@ -71,7 +84,7 @@ def read_octomap_leaves(path: str | os.PathLike[str]) -> OctreeLeaves:
             "reading OctoMap files needs the 'octomap' extra: pip install 'seminspect[octomap]'"
         ) from None
     tree = pyoctomap.OcTree(0.1)  # the file's own resolution replaces this
-    if not tree.readBinary(str(source)):
+    if not tree.readBinary(resolved):
         raise FileFormatError(f"{source}: malformed or truncated OctoMap data")
     centers, sizes, occupied = [], [], []
     for leaf in tree.begin_leafs():
@@ -80,12 +93,14 @@ def read_octomap_leaves(path: str | os.PathLike[str]) -> OctreeLeaves:
         occupied.append(tree.isNodeOccupied(leaf))
     if not centers:
         raise FileFormatError(f"{source}: the OctoMap has no leaves")
-    return OctreeLeaves(
+    arrays = (
         np.asarray(centers, dtype=np.float64),
         np.asarray(sizes, dtype=np.float64),
         np.asarray(occupied, dtype=bool),
-        float(tree.getResolution()),
     )
+    for array in arrays:
+        array.flags.writeable = False  # shared by every caller of the cache
+    return OctreeLeaves(*arrays, float(tree.getResolution()))
 
 
 @numba.njit(cache=True)

@@ -43,15 +43,18 @@ class PointData:
 
 
 def load_point_file(path: str | Path) -> PointData:
-    """Read a ``.ply``, ``.pcd`` or ``.npz`` point file (by extension)."""
+    """Read a ``.ply``, ``.pcd``, ``.npz``, ``.las`` or ``.laz`` point file (by extension)."""
     source = Path(path)
     if source.is_dir():
         raise FileFormatError(f"{source}: is a directory, expected a point file")
-    readers = {".ply": read_ply, ".pcd": read_pcd, ".npz": read_point_npz}
-    reader = readers.get(source.suffix.lower())
+    if source.suffix.lower() in (".las", ".laz"):
+        from seminspect.mapping.formats.las import read_las  # noqa: PLC0415 - needs laspy
+
+        return read_las(source)  # type: ignore[return-value] # PointData's fields and more
+    reader = {".ply": read_ply, ".pcd": read_pcd, ".npz": read_point_npz}.get(source.suffix.lower())
     if reader is None:
         raise FileFormatError(
-            f"{source}: unsupported point file type {source.suffix!r} (use .ply, .pcd or .npz)"
+            f"{source}: unsupported point file type {source.suffix!r} (use ply, pcd, npz, las, laz)"
         )
     return reader(source)
 

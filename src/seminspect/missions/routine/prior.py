@@ -21,9 +21,10 @@ from numpy.typing import NDArray
 
 from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.geometry.transforms import quat_from_yaw
-from seminspect.mapping.voxel import OCCUPIED, VoxelMap, load_map, save_map
+from seminspect.mapping.voxel import VoxelMap, load_map, save_map
 from seminspect.missions.routine.config import RoutineConfig
 from seminspect.missions.routine.tasks import describe_box
+from seminspect.planning.map_files import read_map_file
 from seminspect.robot import Robot
 from seminspect.sensors import Lidar, render
 from seminspect.worlds import World
@@ -36,6 +37,8 @@ SENSE_EVERY_M = 1.0
 #: How far each side of a prior's box may lie from the site's bounds [m]: a point-cloud prior
 #: reaches 1 m past its points, and a coarse OctoMap leaf past the surface it holds.
 EXTENT_MARGIN_M = 2.0
+#: Take-off height of the routine robot above the world's start point [m].
+BODY_HEIGHT_M = 1.5
 #: The arrays :func:`save_prior` adds to a voxel map file (``load_map`` ignores them).
 SITE_FIELDS = ("site_frame", "site_bounds")
 
@@ -50,7 +53,7 @@ def make_robot(world: World, config: RoutineConfig) -> Robot:
         world,
         "aerial",
         radius=config.robot_radius,
-        body_height=1.5,
+        body_height=BODY_HEIGHT_M,
         v_max=config.speed,
         z_min=low,
         z_max=high,
@@ -140,9 +143,16 @@ def check_prior(
         )
     if differences:
         raise InvalidInputError(
-            f"{source}: M_H does not fit the site: {'; '.join(differences)}; record M_H of "
-            "this site with 'seminspect routine map'"
+            f"{source}: M_H does not fit the site: {'; '.join(differences)}; {_fix(source)}"
         )
+
+
+def _fix(source: str | os.PathLike[str]) -> str:
+    """What to do about a prior that does not fit: a map of another site can be a site."""
+    hint = "record M_H of this site with 'seminspect routine map'"
+    if Path(source).suffix.lower() == ".bt":
+        return f"{hint}, or inspect the map's own site with --world {source}"
+    return hint
 
 
 def _read_prior(source: Path, resolution: float) -> tuple[VoxelMap, dict[str, np.ndarray]]:
@@ -176,18 +186,6 @@ def _site_fields(source: Path, prior: VoxelMap) -> dict[str, np.ndarray]:
 
 
 def _foreign_prior(source: Path, suffix: str, resolution: float) -> VoxelMap:
-    if suffix == ".bt":
-        from seminspect.mapping.formats.octomap import load_octomap  # noqa: PLC0415 - optional extra
-
-        return load_octomap(source, resolution)
-    if suffix in (".ply", ".pcd"):
-        from seminspect.mapping.formats.pointfiles import load_point_file  # noqa: PLC0415 - rarely used
-
-        points = load_point_file(source).points
-        if not len(points):
-            raise FileFormatError(f"{source}: the point cloud has no points")
-        prior = VoxelMap.empty(points.min(axis=0) - 1.0, points.max(axis=0) + 1.0, resolution)
-        cells = prior.world_to_index(points)
-        prior.states[tuple(cells.T)] = OCCUPIED
-        return prior
-    raise FileFormatError(f"{source}: a prior map is .npz, .bt, .ply or .pcd")
+    if suffix not in (".bt", ".ply", ".pcd"):
+        raise FileFormatError(f"{source}: a prior map is .npz, .bt, .ply or .pcd")
+    return read_map_file(source, resolution)

@@ -5,7 +5,8 @@ Layout of a routine run (beside the common files of :mod:`~seminspect.runs.direc
     <run>/
       status.json, config.json, events.jsonl, summary.md, trajectory.csv
       map.npz           M_C, the map the robot built in the current world
-      prior/map.npz     M_H, when the command recorded it (no --prior)
+      prior/map.npz     M_H, when the command recorded it (no --prior), or a prior read from
+                        another format (.bt, .ply, .pcd) as painted onto the mission's grid
       tour.json         every task's view poses in visiting order, SA and reference lengths
       views.csv         one row per Algorithm 1 cycle (the time series of 002 Figs 8-11)
       metrics.json      the figures of 002 Sec V and the change report per region
@@ -133,6 +134,8 @@ def run_routine(
     with stop_on_signals():
         run = RunDirectory(out, ROUTINE_LAYOUT)
         with run.claimed(settings):
+            if given is not None and Path(prior_path or "").suffix.lower() != ".npz":
+                save_map(run.path(PRIOR_FILE), given)  # the grid M_C is compared with
             return _run_routine(run, config, site, regions, prior=given, progress=progress)
 
 
@@ -289,8 +292,12 @@ def summary_markdown(metrics: RoutineMetrics) -> str:
     """The run's figures for people."""
     scenario = metrics.scenario
     mode = "adaptive (Algorithm 1)" if metrics.adaptive else "non-adaptive baseline"
+    if scenario.change.get("kind") == "map":
+        title = f"# Routine inspection: the site of {scenario.change.get('map')}"
+    else:
+        title = f"# Routine inspection: mine drift, {scenario.name}, seed {scenario.seed}"
     lines = [
-        f"# Routine inspection: mine drift, {scenario.name}, seed {scenario.seed}",
+        title,
         "",
         f"{metrics.state}: {metrics.stop_reason}; {mode}; change: {scenario.change}",
         "",

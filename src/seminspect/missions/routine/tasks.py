@@ -128,5 +128,8 @@ def _read_document(source: Path) -> object:
 def default_tasks(site: SitePair) -> list[InspectionRegion]:
     """The site's default regions; a user site has none and needs a task file."""
     if not site.tasks:
-        raise InvalidInputError(f"site {site.name!r} has no default tasks; pass a task file")
+        raise InvalidInputError(
+            f"site {site.name!r} has no default tasks; pass a task file (--tasks FILE: regions "
+            "on the site's walls, in its coordinates)"
+        )
     return [InspectionRegion(name, vertices) for name, vertices in site.tasks]

@@ -11,6 +11,7 @@ from seminspect.core.threads import sensor_threads
 from seminspect.mapping.voxel import VoxelMap
 from seminspect.missions.xflie import MissionProgress, XFlie
 from seminspect.missions.xflie.config import MissionConfig, ResolvedMissionConfig, inspects
+from seminspect.missions.xflie.features import warn_about_feature_labels
 from seminspect.missions.xflie.frontier import FrontierMission
 from seminspect.platform.simulated import SimulatedPlatform, mission_noise
 from seminspect.runs.directory import RunDirectory
@@ -44,6 +45,8 @@ def build_mission(
     """The world (made from ``config`` unless given), the robot in it and the executive."""
     world = world or open_world(config.world, config.scenario, seed=config.seed)
     warn_if_no_targets(world, config.target_classes)
+    if inspects(config.planner):
+        warn_about_feature_labels(world, config.target_classes, config.feature_labels)
     platform, ground_z = build_platform(config, world)
     occupancy = mission_map(world, config)
     executive = XFlie if inspects(config.planner) else FrontierMission

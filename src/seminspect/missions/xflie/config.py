@@ -15,6 +15,9 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 from seminspect.core.params import PRESETS, InspectionParams, PresetName
 from seminspect.core.validation import build
 from seminspect.core.vocabulary import BUILDING_FEATURES, VEHICLE_PARTS
+from seminspect.graphs.lsg.naming import check_label
+from seminspect.missions.xflie.features import world_feature_labels
+from seminspect.worlds import World, open_world
 
 Mode = Literal["ground", "aerial"]
 NoiseName = Literal["ideal", "realistic"]
@@ -126,7 +129,11 @@ class MissionConfig(_Strict):
         "apart (mapping.carving: faster, a few free cells stay unknown); None: every ray, exact",
     )
     target_classes: tuple[str, ...] | None = None
-    feature_labels: tuple[str, ...] | None = None
+    feature_labels: tuple[str, ...] | None = Field(
+        None,
+        description="part names recorded as features; None: every part the world's targets "
+        "carry but body, roof and wall (missions.xflie.features)",
+    )
     localisation: Literal["median", "cluster"] = "cluster"
     min_score: float = Field(
         0.6, ge=0, le=1, description="segmentation confidence below which detections are ignored"
@@ -148,6 +155,14 @@ class MissionConfig(_Strict):
         description="a team sharing one 3DLSG, e.g. ('explorer', 'inspector'); None: one robot "
         "that explores and inspects (000)",
     )
+
+    @field_validator("feature_labels")
+    @classmethod
+    def _labels_name_nodes(cls, labels: tuple[str, ...] | None) -> tuple[str, ...] | None:
+        """A feature label names graph nodes: refuse one the graph would refuse mid-mission."""
+        for label in labels or ():
+            check_label(label)
+        return labels
 
     @field_validator("robots")
     @classmethod
@@ -224,24 +239,45 @@ def make_config(values: dict[str, Any]) -> MissionConfig:
     return build(MissionConfig, values, "mission setting")
 
 
-def resolve(config: MissionConfig) -> ResolvedMissionConfig:
-    """Fill every ``None`` field with the world's default."""
+def resolve(config: MissionConfig, world: World | None = None) -> ResolvedMissionConfig:
+    """Fill every ``None`` field with the world's default.
+
+    Unset (or empty) ``feature_labels`` become the parts the world's targets carry
+    (:func:`~seminspect.missions.xflie.features.world_feature_labels`): a user world is read
+    for them unless it is given as ``world``; a built-in world's are its vocabulary
+    (``VEHICLE_PARTS``, ``BUILDING_FEATURES``), which is what its targets carry.
+    """
     defaults = WORLD_DEFAULTS.get(config.world, USER_WORLD_DEFAULTS)
+    classes = config.target_classes or defaults.get("classes", VEHICLE_CLASSES)
     budget = defaults["budget"]
     levels = {"max_levels": defaults["max_levels"]} if "max_levels" in defaults else {}
     inspection = config.inspection or InspectionConfig(d_view=defaults["d_view"], **levels)
     return ResolvedMissionConfig.model_validate(
         dict(config)
         | {
-            "scenario": config.scenario or defaults.get("scenario"),
+            "scenario": default_scenario(config),
             "preset": config.preset or defaults["preset"],
             "mode": config.mode or defaults["mode"],
             "time_budget_s": config.time_budget_s or budget,
-            "target_classes": config.target_classes or defaults.get("classes", VEHICLE_CLASSES),
-            "feature_labels": config.feature_labels or defaults.get("features", VEHICLE_PARTS),
+            "target_classes": classes,
+            "feature_labels": config.feature_labels or _features(config, classes, world),
             "inspection": inspection,
         }
     )
+
+
+def default_scenario(config: MissionConfig) -> str | None:
+    """The scenario a mission runs: the configured one or the world's default."""
+    return config.scenario or WORLD_DEFAULTS.get(config.world, USER_WORLD_DEFAULTS).get("scenario")
+
+
+def _features(
+    config: MissionConfig, classes: tuple[str, ...], world: World | None
+) -> tuple[str, ...]:
+    """The feature labels a mission takes when its configuration names none."""
+    if config.world in WORLD_DEFAULTS:
+        return WORLD_DEFAULTS[config.world].get("features", VEHICLE_PARTS)
+    return world_feature_labels(world or open_world(config.world), classes)
 
 
 def inspects(planner: str) -> bool:

@@ -17,7 +17,12 @@ from collections.abc import Callable, Sequence
 from seminspect.core.interrupts import stop_on_signals
 from seminspect.missions.xflie import MissionProgress
 from seminspect.missions.xflie.build import build_mission, run_name
-from seminspect.missions.xflie.config import MissionConfig, ResolvedMissionConfig, resolve
+from seminspect.missions.xflie.config import (
+    MissionConfig,
+    ResolvedMissionConfig,
+    default_scenario,
+    resolve,
+)
 from seminspect.missions.xflie.figures import mission_metrics
 from seminspect.missions.xflie.layout import OUTPUT_FILES, XFLIE_LAYOUT
 from seminspect.missions.xflie.metrics import CpuMeter, MissionMetrics, QueryAnswer
@@ -44,8 +49,8 @@ def run_mission(
     claimed (see :meth:`RunDirectory.claimed`): a second run on it fails at once, and files of an
     earlier run in it are removed. Ctrl-C and SIGTERM end the mission as ``interrupted``.
     """
-    config = resolve(config)
-    world = open_world(config.world, config.scenario, seed=config.seed)
+    world = open_world(config.world, default_scenario(config), seed=config.seed)
+    config = resolve(config, world)
     with stop_on_signals():
         run = (
             RunDirectory(out, XFLIE_LAYOUT)

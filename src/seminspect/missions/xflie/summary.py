@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Sequence
 from typing import Any
 
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
@@ -40,7 +40,7 @@ def summary_markdown(
     sections.append(_mission_figures(metrics))
     if answers:
         sections.append(_queries_table(answers))
-    sections.append(_targets_table(graph, metrics.table6.surface_coverage_by_target_pct))
+    sections.append(_targets_table(graph, metrics))
     return "\n\n".join("\n".join(lines) for lines in sections) + "\n"  # a blank line between
 
 
@@ -121,17 +121,28 @@ def _queries_table(answers: Sequence[QueryAnswer]) -> list[str]:
     return lines
 
 
-def _targets_table(graph: LayeredSemanticGraph, coverage: Mapping[str, float]) -> list[str]:
+def _targets_table(graph: LayeredSemanticGraph, metrics: MissionMetrics) -> list[str]:
+    """One row per graph target, with the world object it was matched to: the graph names
+    targets in the order it found them (000's convention), the site by its own names."""
+    coverage = metrics.table6.surface_coverage_by_target_pct
+    site_object = site_objects(metrics)
     lines = [
         "## Targets",
         "",
-        "| Target | Status | Levels | Poses | Features | Surface coverage (%) |",
-        "|---|---|---|---|---|---|",
+        "| Target | Site object | Status | Levels | Poses | Features | Surface coverage (%) |",
+        "|---|---|---|---|---|---|---|",
     ]
     for t in graph.targets():
         poses = [p for lv in t.levels for p in lv.poses]
         lines.append(
-            f"| {t.id} | {t.status.value} | {len(t.levels)} | {len(poses)} | "
-            f"{sum(len(p.features) for p in poses)} | {_fmt(coverage.get(t.id), 1)} |"
+            f"| {t.id} | {site_object.get(t.id, '- (false target)')} | {t.status.value} | "
+            f"{len(t.levels)} | {len(poses)} | {sum(len(p.features) for p in poses)} | "
+            f"{_fmt(coverage.get(t.id), 1)} |"
         )
     return lines
+
+
+def site_objects(metrics: MissionMetrics) -> dict[str, str]:
+    """Graph target id -> the name of the world object it was matched to (``metrics.json``
+    keeps the pairs under ``targets.matches``, as ``target_id`` and ``truth``)."""
+    return {match.target_id: match.truth for match in metrics.targets.matches}

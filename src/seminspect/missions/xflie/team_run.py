@@ -20,6 +20,7 @@ from seminspect.mapping.voxel import save_map
 from seminspect.missions.xflie import MissionProgress, XFlie
 from seminspect.missions.xflie.build import build_platform, mission_map
 from seminspect.missions.xflie.config import ResolvedMissionConfig
+from seminspect.missions.xflie.features import warn_about_feature_labels
 from seminspect.missions.xflie.figures import (
     graph_figures,
     mission_figures,
@@ -84,6 +85,7 @@ def build_team(
     graph: LayeredSemanticGraph | None = None
     missions: dict[str, XFlie] = {}
     warn_if_no_targets(world, config.target_classes)
+    warn_about_feature_labels(world, config.target_classes, config.feature_labels)
     shared_map = mission_map(world, config)
     for role in ("explorer", "inspector"):
         platform, ground_z = build_platform(config, world, name=role)
