@@ -6,7 +6,8 @@ with the ray casting on one thread and on two, each row prints:
 
 * env-steps/s: room-steps per second of ``InspectionVectorEnv.step``, observations included
   (dynamics, the camera and LiDAR rays, the robot's map, ego maps, rewards, resets);
-* raw ms: one ``embreex`` ``run`` of the same ray batch (the rays the last step cast, built by
+* raw ms: one call of the rooms' ray caster (``worlds.raycast.RayCaster.cast``: Embree, one
+  thread) on the same ray batch (the rays the last step cast, built by
   ``missions.learning.sensors.sensor_rays``), the floor a step cannot go below;
 * env/raw: the step's time over that floor.
 
@@ -46,7 +47,7 @@ def step_rate(env: InspectionVectorEnv, controller, steps: int) -> float:
 
 
 def raw_cast_seconds(env: InspectionVectorEnv, repeats: int = 5) -> tuple[float, int]:
-    """Median time of one raw Embree run of the rays the environment casts now, and their count."""
+    """Median time of one cast of the rays the environment casts now, and their count."""
     every = np.arange(env.num_envs)
     rooms = env.rooms
     shift = np.outer(every * env._spacing, (1.0, 0.0, 0.0))
@@ -63,12 +64,10 @@ def raw_cast_seconds(env: InspectionVectorEnv, repeats: int = 5) -> tuple[float,
         env.config.camera_range,
     )
     caster = env._caster
-    shifted = (starts - caster.offset).astype(np.float32)
-    limit = np.full(len(dirs), env.config.camera_range, dtype=np.float32)
     times = []
     for _ in range(repeats):
         start = time.perf_counter()
-        caster._scene.run(shifted, dirs, dists=limit, output=1)
+        caster.cast(starts, dirs, env.config.camera_range)
         times.append(time.perf_counter() - start)
     return float(np.median(times)), len(dirs)
 

@@ -16,3 +16,18 @@ def test_the_script_imports(name: str) -> None:
     if name in NEEDS:
         pytest.importorskip(NEEDS[name])
     assert callable(getattr(bench_script(name), "main", None)), f"bench/{name}.py has no main()"
+
+
+def test_the_rl_environment_benchmark_runs(monkeypatch, capsys) -> None:
+    """bench/rl_env.py reached into the ray caster's private scene and stopped running; its
+    quick form (a few seconds) runs here so that its published speeds stay regenerable."""
+    monkeypatch.setattr("sys.argv", ["rl_env.py", "--quick"])
+    bench_script("rl_env").main()
+    rows = [line.split() for line in capsys.readouterr().out.splitlines()[1:]]
+    assert [(r[0], r[1], r[2]) for r in rows] == [
+        (rooms, policy, threads)
+        for rooms in ("1", "8", "64")
+        for policy in ("random", "orbit")
+        for threads in ("1", "2")
+    ]
+    assert all(float(r[3].replace(",", "")) > 0 and float(r[6]) > 0 for r in rows)
