@@ -87,11 +87,16 @@ def _room_bt(path, size=(30, 20, 15), resolution=0.2):
     return path
 
 
-def test_an_octomap_is_the_site_with_world_and_refused_as_the_drifts_prior(capsys, tmp_path):
-    bt = _room_bt(tmp_path / "room.bt")
-    tasks = tmp_path / "tasks.yaml"
+def _room_site(folder):
+    """The room OctoMap and a task file of one region on its east wall."""
+    tasks = folder / "tasks.yaml"
     region = [[5.8, 1.2, 0.8], [5.8, 2.8, 0.8], [5.8, 2.8, 2.0], [5.8, 1.2, 2.0]]
     tasks.write_text(f"regions:\n  - name: east\n    vertices: {region}\n")
+    return _room_bt(folder / "room.bt"), tasks
+
+
+def test_an_octomap_is_the_site_with_world_and_refused_as_the_drifts_prior(capsys, tmp_path):
+    bt, tasks = _room_site(tmp_path)
     code, out, err = run(
         capsys, "routine", "inspect", "--world", str(bt), "--tasks", str(tasks),
         "--out", str(tmp_path / "run"),
@@ -112,10 +117,7 @@ def test_an_octomap_is_the_site_with_world_and_refused_as_the_drifts_prior(capsy
 
 
 def test_the_results_line_names_no_pictures_that_were_not_drawn(capsys, tmp_path):
-    bt = _room_bt(tmp_path / "room.bt")
-    tasks = tmp_path / "tasks.yaml"
-    region = [[5.8, 1.2, 0.8], [5.8, 2.8, 0.8], [5.8, 2.8, 2.0], [5.8, 1.2, 2.0]]
-    tasks.write_text(f"regions:\n  - name: east\n    vertices: {region}\n")
+    bt, tasks = _room_site(tmp_path)
     code, out, err = run(
         capsys, "routine", "inspect", "--world", str(bt), "--tasks", str(tasks),
         "--no-pictures", "--out", str(tmp_path / "run"),

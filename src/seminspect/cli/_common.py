@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import signal
+from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn
 
@@ -84,3 +85,11 @@ def _check_parent(path: Path) -> None:
         raise InvalidInputError(f"{path}: {parent} is not a directory")
     if not os.access(parent, os.W_OK | os.X_OK):
         raise InvalidInputError(f"{path}: {parent} is not writable; choose another location")
+
+
+def existing_outputs(run_dir: Path, names: Sequence[str]) -> list[str]:
+    """Those of ``names`` that exist in the run directory, then how many pictures it holds, so
+    a results line promises nothing absent."""
+    named = [name for name in names if (run_dir / name).exists()]
+    pictures = len(list(run_dir.glob("*.png")))
+    return named + ([f"{pictures} pictures (*.png)"] if pictures else ["no pictures"])

@@ -8,7 +8,14 @@ from pathlib import Path
 
 import typer
 
-from seminspect.cli._common import console, err_console, exit_stopped, labelled, writable_directory
+from seminspect.cli._common import (
+    console,
+    err_console,
+    existing_outputs,
+    exit_stopped,
+    labelled,
+    writable_directory,
+)
 
 
 class ModeChoice(str, Enum):
@@ -273,8 +280,6 @@ def _print_result(result) -> None:
 
 def _outputs(run_dir: Path) -> list[str]:
     """The run's main outputs that exist, so the results line promises nothing absent."""
-    from seminspect.report.html import existing_outputs
-
     return existing_outputs(run_dir, ("report.html", "summary.md", "graph.json"))
 
 

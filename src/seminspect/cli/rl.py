@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from seminspect.cli._common import console, progress_bar
+from seminspect.cli._common import console, existing_outputs, progress_bar
 
 app = typer.Typer(no_args_is_help=True, help="Learned semantic inspection in rooms (004).")
 
@@ -98,7 +98,7 @@ def eval_command(
     from seminspect.core.errors import InvalidInputError
     from seminspect.missions.learning.evaluation import EpisodeTrace, evaluate
     from seminspect.report.figures import save_figure
-    from seminspect.report.html import existing_outputs, write_rl_report
+    from seminspect.report.html import write_rl_report
     from seminspect.report.rl import coverage_figure, write_episode_pictures
 
     counts = parse_obstacles(obstacles)

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from seminspect.cli._common import console, exit_stopped, labelled, progress_bar
+from seminspect.cli._common import console, existing_outputs, exit_stopped, labelled, progress_bar
 
 app = typer.Typer(no_args_is_help=True, help="Routine inspection on an outdated map (002).")
 
@@ -37,14 +37,14 @@ def _config_and_site(world, scenario, seed, length, historical, current, *, need
     """The settings, and the user's site pair when --historical/--current are given."""
     from seminspect.core.errors import InvalidInputError
     from seminspect.missions.routine.config import RoutineConfig
-    from seminspect.missions.routine.map_site import SITE_KIND, is_map_file, map_site
+    from seminspect.missions.routine.site_from_map import SITE_KIND, is_map_file, site_from_map
     from seminspect.worlds.routine_sites import user_site, world_files
 
     if is_map_file(world):
         if historical is not None or current is not None:
             raise InvalidInputError("--world MAP builds the site: leave out --historical/--current")
         config = RoutineConfig(world=SITE_KIND, scenario=SITE_KIND, seed=seed, length=length)
-        return config, map_site(world, config)
+        return config, site_from_map(world, config)
     if historical is None and current is None:
         return RoutineConfig(world=world, scenario=scenario, seed=seed, length=length), None
     if historical is None or (need_current and current is None):
@@ -158,8 +158,6 @@ def _print_result(name: str, result) -> None:
         f"{_num(m.view_distance_mae_m)} m, ROI coverage {_num(m.roi_coverage_pct, 1)} %, "
         f"max Γ_s {_num(m.gamma_s_max)}, collisions {m.collisions}"
     )
-    from seminspect.report.html import existing_outputs
-
     # unwrapped: paths are copied from this line; it names only what the run holds
     outputs = ", ".join(existing_outputs(result.run_dir, _OUTPUTS))
     console.print(f"  results: {result.run_dir} ({outputs})", soft_wrap=True)

@@ -71,7 +71,6 @@ class BareCloudLabels:
 
     labels: NDArray[np.int64]  # GROUND, OBJECT or OUTLIER per point
     objects: NDArray[np.int64]  # cluster id per point, -1 for ground and outliers
-    height: NDArray[np.float64]  # height above the ground surface [m]
     spacing: float  # median nearest-neighbour spacing [m]
     cell: float  # grid cell of the filter [m]
     eps: float  # DBSCAN radius of the object clustering [m]
@@ -199,7 +198,6 @@ def label_bare_cloud(
     seconds["spacing"] = time.perf_counter() - start
     start = time.perf_counter()
     ground = progressive_morphological_filter(cloud, cell, params, initial_height(spacing, params))
-    height = height_above_ground(cloud, ground, cell)
     seconds["ground"] = time.perf_counter() - start
     start = time.perf_counter()
     objects = np.full(len(cloud), -1, dtype=np.int64)
@@ -209,7 +207,7 @@ def label_bare_cloud(
         objects[above] = dbscan_labels(cloud[above], eps, params.min_object_points)
     seconds["objects"] = time.perf_counter() - start
     labels = np.where(ground, GROUND, np.where(objects >= 0, OBJECT, OUTLIER)).astype(np.int64)
-    return BareCloudLabels(labels, objects, height, spacing, cell, eps, seconds)
+    return BareCloudLabels(labels, objects, spacing, cell, eps, seconds)
 
 
 def filter_errors(predicted_ground: NDArray[np.bool_], true_ground: NDArray[np.bool_]) -> dict:

@@ -76,9 +76,6 @@ class FreeSpace:
     def volume_m3(self, component: int) -> float:
         return self.size_of(component) * self.grid.resolution ** (2 if self.grid.planar else 3)
 
-    def centres(self, cells: NDArray[np.int64], z: float = 0.0) -> NDArray[np.float64]:
-        return self.grid.centres(cells, z)
-
     @cached_property
     def _tree(self) -> cKDTree:
         return cKDTree(self._points(self.cells))

@@ -18,7 +18,6 @@ test) can check the figure against the files.
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
 from pathlib import Path
 
 from seminspect.core.errors import FileFormatError, InvalidInputError
@@ -55,7 +54,6 @@ __all__ = [
     "THUMBNAIL_QUALITY",
     "THUMBNAIL_WIDTH",
     "Section",
-    "existing_outputs",
     "key_value_table",
     "mission_scene_figure",
     "path_plot",
@@ -116,11 +114,3 @@ def run_kind(run_dir: str | os.PathLike[str]) -> str:
 def write_report(run_dir: str | os.PathLike[str]) -> Path:
     """Write ``report.html`` for any run directory (:func:`run_kind`); returns its path."""
     return _WRITERS[run_kind(run_dir)](Path(run_dir))
-
-
-def existing_outputs(run_dir: Path, names: Sequence[str]) -> list[str]:
-    """Those of ``names`` that exist in the run directory, then how many pictures it holds, so
-    a results line promises nothing absent."""
-    named = [name for name in names if (run_dir / name).exists()]
-    pictures = len(list(run_dir.glob("*.png")))
-    return named + ([f"{pictures} pictures (*.png)"] if pictures else ["no pictures"])

@@ -7,7 +7,6 @@ places, regions and the map root, lifted as in 001 Fig 1 and coloured by prompt.
 from __future__ import annotations
 
 import html
-import json
 import os
 from collections.abc import Mapping
 from pathlib import Path
@@ -17,6 +16,7 @@ import numpy as np
 import plotly.graph_objects as go
 from numpy.typing import NDArray
 
+from seminspect.core.io import read_json
 from seminspect.graphs.terrain.io import load_terrain_graph
 from seminspect.graphs.terrain.scene_graph import TerrainSceneGraph
 from seminspect.report.html_page import (
@@ -45,7 +45,7 @@ def write_terrain_report(run_dir: str | os.PathLike[str]) -> Path:
     summary_file = root / "summary.json"
     sections = [Section("Graph", key_value_table(scene.summary()))]
     if summary_file.is_file():
-        sections.append(Section("Run", key_value_table(json.loads(summary_file.read_text()))))
+        sections.append(Section("Run", key_value_table(read_json(summary_file))))
     figures = [("scene", terrain_scene_figure(scene))]
     title = f"Terrain scene graph {root.name}"
     return write_page(root / REPORT_FILE, title, figures, sections, {})

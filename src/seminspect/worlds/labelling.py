@@ -5,16 +5,31 @@ part that the single-mesh labels files of ``worlds.user`` and the site files of
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from pathlib import Path
+from typing import Any, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.worlds.builder import WorldBuilder
 from seminspect.worlds.collision import check_grid_sizes
 from seminspect.worlds.world import BACKGROUND, World
+
+_Document = TypeVar("_Document", bound=BaseModel)
+
+
+def validated(model: type[_Document], document: Any, path: Path) -> _Document:
+    """``document`` read into ``model``, or a ``FileFormatError`` naming the file, the key and
+    what is wrong with its value (the first problem found)."""
+    try:
+        return model.model_validate(document)
+    except ValidationError as exc:
+        first = exc.errors()[0]
+        where = ".".join(str(part) for part in first["loc"]) or "document"
+        raise FileFormatError(f"{path}: {where}: {first['msg']}") from None
+
 
 Box = tuple[tuple[float, float, float], tuple[float, float, float]]
 #: How to shrink a world too large for its collision grids.

@@ -19,6 +19,8 @@ from numpy.typing import NDArray
 from seminspect.core.errors import FileFormatError
 
 MESH_SUFFIXES = (".obj", ".ply", ".glb", ".gltf", ".stl", ".off", ".dae")
+#: Turns a Y-up mesh (glTF, many OBJ and COLLADA exports) Z-up: (x, y, z) -> (x, -z, y).
+Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
 #: Refuse meshes above this size before parsing them.
 MAX_MESH_BYTES = 512 << 20
 COLLADA_HINT = "install the extra with pip install 'seminspect[collada]'"
@@ -157,13 +159,13 @@ def _collada_mesh(path: Path) -> tuple[NDArray, NDArray, list[str], NDArray]:
         start += len(triangles)
     points = np.vstack([p for _, p, _ in pieces]) * float(document.assetInfo.unitmeter or 1.0)
     if document.assetInfo.upaxis == "Y_UP":
-        points = points @ np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+        points = points @ Y_UP
     return points, faces, groups, member
 
 
 def _offsets(pieces: list[tuple[list[str], NDArray, NDArray]]) -> list[int]:
     counts = [len(points) for _, points, _ in pieces]
-    return [sum(counts[:k]) for k in range(len(counts))]
+    return np.cumsum([0, *counts[:-1]]).tolist()
 
 
 def _collada_node(node: Any, matrix: NDArray, pieces: list) -> None:

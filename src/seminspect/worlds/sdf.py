@@ -33,12 +33,12 @@ from typing import Literal
 import numpy as np
 import trimesh
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field
 
 from seminspect.core.errors import FileFormatError
 from seminspect.core.io import read_yaml
 from seminspect.worlds.checks import WorldWarning
-from seminspect.worlds.labelling import Entry, Ground, assign_labels
+from seminspect.worlds.labelling import Entry, Ground, assign_labels, validated
 from seminspect.worlds.meshes import MeshData, read_mesh
 from seminspect.worlds.pieces import Layout, Placed, assemble, transform
 from seminspect.worlds.shapes import pose_matrix
@@ -136,17 +136,14 @@ def read_class_map(path: Path) -> ClassMap:
     document = read_yaml(path)
     if not isinstance(document, dict) or not isinstance(document.get("classes"), dict):
         raise FileFormatError(f"{path}: expected 'classes:' mapping model names to classes")
-    try:
-        return _ClassMapFile.model_validate(document).classes
-    except ValidationError as exc:
-        first = exc.errors()[0]
-        where = ".".join(str(part) for part in first["loc"]) or "document"
-        raise FileFormatError(f"{path}: {where}: {first['msg']}") from None
+    return validated(_ClassMapFile, document, path).classes
 
 
 def _world_name(path: Path) -> str:
     root = _parse(path)
-    named = root.find("world") if root.find("world") is not None else root.find("model")
+    named = root.find("world")
+    if named is None:
+        named = root.find("model")
     return path.stem if named is None else named.get("name", path.stem)
 
 
@@ -244,7 +241,7 @@ class _Reader:
             inner = f"{label}::{nested.get('name')}"
             self._model(nested, path, matrix, inner, depth, keep_pose=True)
         for include in model.findall("include"):
-            self._include(include, path, matrix, depth + 1, label)
+            self._include(include, path, matrix, depth, label)  # read_file counts it
         if kind is not None:
             missing = sorted(set(kind.parts) - obj.groups_seen)
             if missing:

@@ -37,12 +37,12 @@ from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from seminspect.core.errors import FileFormatError
 from seminspect.core.io import read_json, read_yaml
-from seminspect.worlds.labelling import Box, Entry, Ground, Start, assign_labels
-from seminspect.worlds.meshes import MeshData
+from seminspect.worlds.labelling import Box, Entry, Ground, Start, assign_labels, validated
+from seminspect.worlds.meshes import Y_UP, MeshData
 from seminspect.worlds.pieces import Layout, Placed, assemble, transform
 from seminspect.worlds.sdf import ClassMap, MeshCache, forward_angle, load_sdf_pieces
 from seminspect.worlds.shapes import pose_matrix
@@ -51,7 +51,6 @@ from seminspect.worlds.world import World
 SITE_FORMAT = "seminspect-site"
 SITE_SUFFIXES = (".json", ".yaml", ".yml")
 Forward = Literal["x", "-x", "y", "-y"]
-_Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
 
 
 class _Mesh(BaseModel):
@@ -118,12 +117,7 @@ def read_site(path: Path) -> _Site:
     document = _read_document(path)
     if not isinstance(document, dict):
         raise FileFormatError(f"{path}: expected a mapping at the top level")
-    try:
-        site = _Site.model_validate(document)
-    except ValidationError as exc:
-        first = exc.errors()[0]
-        where = ".".join(str(part) for part in first["loc"]) or "document"
-        raise FileFormatError(f"{path}: {where}: {first['msg']}") from None
+    site = validated(_Site, document, path)
     for index, mesh in enumerate(site.meshes):
         if mesh.labels is not None and mesh.parts is not None:
             raise FileFormatError(f"{path}: meshes[{index}]: give 'labels' or 'parts', not both")
@@ -202,7 +196,7 @@ def _local_vertices(data: MeshData, mesh: _Mesh) -> NDArray[np.float64]:
     """The mesh in its object's frame: scaled, Z-up, its front along +x."""
     points = data.vertices * np.broadcast_to(np.asarray(mesh.scale, float), (3,))
     if mesh.up == "y":
-        points = points @ _Y_UP
+        points = points @ Y_UP
     return transform(points, pose_matrix(yaw=-forward_angle(mesh.forward)))
 
 

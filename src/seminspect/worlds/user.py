@@ -37,7 +37,7 @@ from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field
 
 from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.core.io import atomic_write_bytes, read_json, read_yaml, write_versioned_json
@@ -50,8 +50,9 @@ from seminspect.worlds.labelling import (
     add_labelled,
     assign_labels,
     finish_world,
+    validated,
 )
-from seminspect.worlds.meshes import MESH_SUFFIXES, read_mesh
+from seminspect.worlds.meshes import MESH_SUFFIXES, Y_UP, read_mesh
 from seminspect.worlds.sdf import SDF_SUFFIXES, load_sdf
 from seminspect.worlds.shapes import pose_matrix
 from seminspect.worlds.site import is_site_file, load_site
@@ -86,18 +87,13 @@ def _read_labels(path: Path) -> _Labels:
     document = read_yaml(path) if is_yaml else read_json(path)
     if not isinstance(document, dict):
         raise FileFormatError(f"{path}: expected a mapping at the top level")
-    try:
-        return _Labels.model_validate(document)
-    except ValidationError as exc:
-        first = exc.errors()[0]
-        where = ".".join(str(part) for part in first["loc"]) or "document"
-        raise FileFormatError(f"{path}: {where}: {first['msg']}") from None
+    return validated(_Labels, document, path)
 
 
 def _transform(labels: _Labels, vertices: NDArray) -> NDArray:
     points = vertices * labels.scale
     if labels.up == "y":
-        points = points @ np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+        points = points @ Y_UP
     return points
 
 

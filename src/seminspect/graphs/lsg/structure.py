@@ -34,6 +34,7 @@ from seminspect.graphs.lsg.model import (
     RobotNode,
     TargetNode,
     TargetStatus,
+    edge_key,
 )
 from seminspect.graphs.lsg.population import LayerPopulation, PopulationStats
 from seminspect.graphs.lsg.union import UnifiedGraph
@@ -83,7 +84,7 @@ class GraphStructure:
         return iter(self.unified.edges.values())
 
     def edge(self, u: str, v: str) -> Edge | None:
-        return self.unified.edges.get((u, v) if u <= v else (v, u))
+        return self.unified.edges.get(edge_key(u, v))
 
     def targets(self, status: TargetStatus | None = None) -> list[TargetNode]:
         """Target nodes in registration order, optionally only those of one status."""

@@ -79,14 +79,6 @@ def mutual_information(px: NDArray[np.float64], py_x: NDArray[np.float64]) -> fl
     return max(float(np.sum(px[:, None] * py_x * np.log2(ratio))), 0.0)
 
 
-def merge_cost(pi: float, pj: float, yi: NDArray[np.float64], yj: NDArray[np.float64]) -> float:
-    """Information lost by merging two clusters: ``(p_i + p_j) · JS_π`` (Slonim and Tishby)."""
-    total = pi + pj
-    wi, wj = pi / total, pj / total
-    js = _entropy(wi * yi + wj * yj) - wi * _entropy(yi) - wj * _entropy(yj)
-    return total * max(js, 0.0)
-
-
 @dataclass
 class _Clusters:
     """The bottleneck's working state: each live cluster's weight, task mix and x-y box."""
@@ -99,15 +91,15 @@ class _Clusters:
     entropy: dict[int, float]  # H(Y|c) of each cluster, kept to price merges three times faster
 
     def entry(self, a: int, b: int) -> tuple[float, float, int, int, int, int]:
-        """Heap key of merging ``a`` and ``b``: loss (free below the tolerance), then size."""
+        """Heap key of merging ``a`` and ``b``: the information lost, ``(p_i + p_j) · JS_π``
+        (Slonim and Tishby; free below the tolerance), then the merged size."""
         lo, hi = min(a, b), max(a, b)
         total = self.weight[lo] + self.weight[hi]
         wi, wj = self.weight[lo] / total, self.weight[hi] / total
         mixed = _entropy(wi * self.mix[lo] + wj * self.mix[hi])
         cost = total * max(mixed - wi * self.entropy[lo] - wj * self.entropy[hi], 0.0)
         free = 0.0 if cost <= FREE_MERGE else cost
-        size = self.weight[lo] + self.weight[hi]
-        return (free, size, lo, hi, self.version[lo], self.version[hi])
+        return (free, total, lo, hi, self.version[lo], self.version[hi])
 
     def extent(self, a: int, b: int) -> float:
         """Diagonal of the x-y box of the two clusters' members together, metres."""

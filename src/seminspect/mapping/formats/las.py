@@ -116,9 +116,10 @@ def header_units(header) -> tuple[str | None, str | None, str]:
     for vlr in header.vlrs:
         wkt = getattr(vlr, "string", None)
         if isinstance(wkt, str):
-            unit = wkt_linear_unit(wkt)
+            # a compound CRS names its vertical CRS (and its unit) after the horizontal one
+            unit = wkt_linear_unit(re.split(r"VERT_CS|VERTCRS|VERTICALCRS", wkt)[0])
             if unit is not None:
-                return unit, unit, "WKT"
+                return unit, wkt_linear_unit(wkt) or unit, "WKT"
     return None, None, ""
 
 

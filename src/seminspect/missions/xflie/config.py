@@ -6,6 +6,7 @@ form (every default filled in), so a run can be repeated from its ``config.json`
 
 from __future__ import annotations
 
+import functools
 import math
 import typing
 from typing import Any, Literal
@@ -277,7 +278,16 @@ def _features(
     """The feature labels a mission takes when its configuration names none."""
     if config.world in WORLD_DEFAULTS:
         return WORLD_DEFAULTS[config.world].get("features", VEHICLE_PARTS)
-    return world_feature_labels(world or open_world(config.world), classes)
+    if world is not None:
+        return world_feature_labels(world, classes)
+    return _user_world_features(config.world, classes)
+
+
+@functools.lru_cache(maxsize=8)
+def _user_world_features(path: str, classes: tuple[str, ...]) -> tuple[str, ...]:
+    """A user world's feature labels, read once per process: a sweep resolves every task's
+    configuration, and the mesh need not be loaded for each just to list its parts."""
+    return world_feature_labels(open_world(path), classes)
 
 
 def inspects(planner: str) -> bool:

@@ -10,7 +10,7 @@ import yaml
 
 from seminspect.core.errors import InvalidInputError
 from seminspect.missions.routine import RoutineConfig, run_routine
-from seminspect.missions.routine.map_site import map_site
+from seminspect.missions.routine.site_from_map import site_from_map
 from seminspect.missions.routine.tasks import default_tasks, load_tasks
 from seminspect.worlds.voxels import world_from_voxels
 
@@ -51,7 +51,7 @@ def test_a_slab_of_voxels_becomes_a_surface_on_its_cell_faces() -> None:
 
 
 def test_the_site_of_a_room_starts_inside_it_clear_of_the_walls(tmp_path: Path) -> None:
-    site = map_site(write_room_bt(tmp_path / "room.bt"), CONFIG)
+    site = site_from_map(write_room_bt(tmp_path / "room.bt"), CONFIG)
     assert site.historical is site.current
     start = site.historical.start_position
     assert np.allclose(start[:2], [3.0, 2.0], atol=0.3)  # the room's middle
@@ -64,18 +64,18 @@ def test_the_site_of_a_room_starts_inside_it_clear_of_the_walls(tmp_path: Path) 
 def test_a_map_without_free_space_cannot_be_a_site(tmp_path: Path) -> None:
     solid = write_room_bt(tmp_path / "solid.bt", size=(12, 12, 12), free_inside=False)
     with pytest.raises(InvalidInputError, match=r"solid.bt: no known-free space"):
-        map_site(solid, CONFIG)
+        site_from_map(solid, CONFIG)
 
 
 def test_a_map_with_too_little_free_space_is_refused(tmp_path: Path) -> None:
     closet = write_room_bt(tmp_path / "closet.bt", size=(10, 10, 22))  # 1.6 x 1.6 m inside
     with pytest.raises(InvalidInputError, match=r"closet.bt: its largest free space is"):
-        map_site(closet, CONFIG)
+        site_from_map(closet, CONFIG)
 
 
 def test_a_routine_run_in_a_map_built_room_completes_without_collisions(tmp_path: Path) -> None:
     bt = write_room_bt(tmp_path / "room.bt")
-    site = map_site(bt, CONFIG)
+    site = site_from_map(bt, CONFIG)
     tasks = east_wall_tasks(tmp_path / "tasks.yaml")
     assert load_tasks(tasks, site)
     result = run_routine(CONFIG, tmp_path / "run", prior_path=bt, tasks_path=tasks, site=site)
@@ -91,7 +91,7 @@ def test_a_routine_run_in_a_map_built_room_completes_without_collisions(tmp_path
 
 def test_the_freiburg_map_is_a_site_that_starts_in_its_corridor(shared_data) -> None:
     pytest.importorskip("pyoctomap")
-    site = map_site(shared_data / "octomap" / "geb079.bt", CONFIG)
+    site = site_from_map(shared_data / "octomap" / "geb079.bt", CONFIG)
     start = site.historical.start_position + np.array([0.0, 0.0, 1.5])
     assert -1.3 < start[1] < 1.2 and -6.5 < start[0] < 28.0  # the corridor's floor plan
     assert site.historical.is_free(start[None], CONFIG.robot_radius)[0]

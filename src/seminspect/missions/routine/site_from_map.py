@@ -12,6 +12,7 @@ tour in, is refused with the reason.
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 
@@ -43,12 +44,16 @@ def is_map_file(name: str | os.PathLike[str]) -> bool:
     return Path(name).suffix.lower() in MAP_SUFFIXES
 
 
-def map_site(path: str | os.PathLike[str], config: RoutineConfig) -> SitePair:
+def site_from_map(path: str | os.PathLike[str], config: RoutineConfig) -> SitePair:
     """The site of a map file, as the module docstring says; a map that cannot host a routine
     run is an :class:`InvalidInputError` naming the file and the reason."""
     source = Path(path)
     voxels = read_map_file(source)  # the map's own cells make the world
-    prior = read_map_file(source, config.map_resolution)  # M_H's grid: where the start is chosen
+    prior = (  # M_H's grid: where the start is chosen
+        voxels
+        if math.isclose(voxels.resolution, config.map_resolution, rel_tol=1e-6)
+        else read_map_file(source, config.map_resolution)
+    )
     # the robot takes off BODY_HEIGHT_M above the world's start point
     start = robot_start(prior, config, source, lowest=float(voxels.origin[2]) + BODY_HEIGHT_M)
     start[2] -= BODY_HEIGHT_M
