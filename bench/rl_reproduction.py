@@ -1,10 +1,12 @@
 """004 Tables I-III with the shipped policy, its ablations and the baselines, beside the paper.
 
 Every controller meets the same rooms (seed 0, 100 episodes per obstacle count, 90 s each; the
-rooms are drawn per batch and per room, see ``missions.learning.evaluation``). The evaluations
-are kept as JSON in ``docs/data/rl/``; the tables of docs/reproduction.md are made from those
-files by ``seminspect.studies.learning``, and ``tests/studies/learning/test_tables.py`` checks
-that the document still matches them.
+rooms are drawn per batch and per room, see ``missions.learning.evaluation``) and is flown with
+the observations and rewards of the environment it was trained in (its checkpoint's); each
+learned evaluation records its checkpoint's SHA-256. The evaluations are kept as JSON in
+``docs/data/rl/``; the tables of docs/reproduction.md are made from those files by
+``seminspect.studies.learning``, and ``tests/studies/learning/test_tables.py`` checks that the
+document still matches them.
 
 * ``rl-table1``: the shipped policy, the orbit and the random controllers at 0/4/9/14/19
   obstacles (004 Table I);
@@ -29,9 +31,14 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+from seminspect.core.io import file_sha256
 from seminspect.missions.learning.agent import load_controller, shipped_policy_path
 from seminspect.missions.learning.baselines import Controller, OrbitController, RandomController
-from seminspect.missions.learning.evaluation import EvaluationResult, evaluate
+from seminspect.missions.learning.evaluation import (
+    EvaluationResult,
+    controller_evaluation_config,
+    evaluate,
+)
 from seminspect.missions.learning.rooms import TABLE1_OBSTACLES
 from seminspect.report.figures import save_figure
 from seminspect.report.markdown import rewrite_sections
@@ -59,21 +66,13 @@ TRAINING_LOGS = {
 }
 SEED, EPISODES, ENVS = 0, 100, 50
 
-#: Evaluation file -> (controller factory, obstacle counts, policy label).
-EVALUATIONS: dict[str, tuple[Callable[[], Controller], tuple[int, ...], str]] = {
-    "table1-learned": (lambda: load_controller(None), TABLE1_OBSTACLES, "learned (shipped)"),
+#: Evaluation file -> (baseline factory or checkpoint file, obstacle counts, policy label).
+EVALUATIONS: dict[str, tuple[Callable[[], Controller] | Path, tuple[int, ...], str]] = {
+    "table1-learned": (shipped_policy_path(), TABLE1_OBSTACLES, "learned (shipped)"),
     "table1-orbit": (OrbitController, TABLE1_OBSTACLES, "orbit"),
     "table1-random": (lambda: RandomController(SEED), TABLE1_OBSTACLES, "random"),
-    "ablation-no-svs": (
-        lambda: load_controller(CHECKPOINTS / "no-svs.pt"),
-        (ABLATION_OBSTACLES,),
-        "no SVS map",
-    ),
-    "ablation-no-gru": (
-        lambda: load_controller(CHECKPOINTS / "no-gru.pt"),
-        (ABLATION_OBSTACLES,),
-        "no GRU",
-    ),
+    "ablation-no-svs": (CHECKPOINTS / "no-svs.pt", (ABLATION_OBSTACLES,), "no SVS map"),
+    "ablation-no-gru": (CHECKPOINTS / "no-gru.pt", (ABLATION_OBSTACLES,), "no GRU"),
 }
 
 
@@ -83,8 +82,22 @@ def log(text: str) -> None:
 
 def run_evaluation(name: str, episodes: int, data: Path) -> EvaluationResult:
     """Evaluate one controller and keep its JSON under ``data``."""
-    factory, counts, label = EVALUATIONS[name]
-    result = evaluate(factory(), counts, episodes, SEED, num_envs=ENVS, policy=label)
+    source, counts, label = EVALUATIONS[name]
+    controller: Controller
+    if isinstance(source, Path):
+        controller, digest = load_controller(source), file_sha256(source)
+    else:
+        controller, digest = source(), None
+    result = evaluate(
+        controller,
+        counts,
+        episodes,
+        SEED,
+        config=controller_evaluation_config(controller),
+        num_envs=ENVS,
+        policy=label,
+        checkpoint_sha256=digest,
+    )
     result.to_json(data / f"{name}.json")
     log(f"{name}: {result.wall_seconds:.0f} s")
     return result

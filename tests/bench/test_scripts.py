@@ -19,15 +19,18 @@ def test_the_script_imports(name: str) -> None:
 
 
 def test_the_rl_environment_benchmark_runs(monkeypatch, capsys) -> None:
-    """bench/rl_env.py reached into the ray caster's private scene and stopped running; its
-    quick form (a few seconds) runs here so that its published speeds stay regenerable."""
+    """bench/rl_env.py reached into the ray caster's private scene, and later cast with the
+    old cylinder arguments, and stopped running; its quick form (1 and 8 rooms of both sets)
+    runs here so that its published speeds stay regenerable."""
     monkeypatch.setattr("sys.argv", ["rl_env.py", "--quick"])
     bench_script("rl_env").main()
     rows = [line.split() for line in capsys.readouterr().out.splitlines()[1:]]
-    assert [(r[0], r[1], r[2]) for r in rows] == [
-        (rooms, policy, threads)
-        for rooms in ("1", "8", "64")
+    assert [tuple(r[:4]) for r in rows] == [
+        (rooms_set, rooms, policy, threads)
+        for rooms_set in ("train", "table1")
+        for rooms in ("1", "8")
         for policy in ("random", "orbit")
         for threads in ("1", "2")
     ]
-    assert all(float(r[3].replace(",", "")) > 0 and float(r[6]) > 0 for r in rows)
+    assert all(float(r[4].replace(",", "")) > 0 and float(r[8]) > 0 for r in rows)
+    assert all(0 <= int(r[6].rstrip("%")) <= 100 for r in rows)  # the in-view share

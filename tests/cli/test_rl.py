@@ -3,22 +3,30 @@
 import pytest
 
 from cli_runner import run
-from seminspect.missions.learning.evaluation import EvaluationResult
+from seminspect.core.io import file_sha256
+from seminspect.missions.learning.env_config import EnvConfig
+from seminspect.missions.learning.evaluation import EvaluationResult, evaluation_config
 
 
 def test_eval_writes_the_json_the_pictures_the_report_and_a_table_beside_table_1(capsys, tmp_path):
     out = tmp_path / "eval"
     code, stdout, err = run(
         capsys, "rl", "eval", "--policy", "orbit", "--obstacles", "0,4", "--episodes", "1",
-        "--envs", "1", "--out", str(out),
+        "--envs", "1", "--shapes", "box", "--out", str(out),
     )  # fmt: skip
     assert code == 0, err
     result = EvaluationResult.from_json(out / "evaluation.json")
     assert [r.obstacles for r in result.results] == [0, 4]
     assert result.policy == "orbit" and result.at(0).episodes == 1
+    assert result.checkpoint_sha256 is None  # a baseline
+    assert result.config == evaluation_config(EnvConfig(), ("box",))  # the protocol's rooms
     assert (out / "coverage.png").exists() and (out / "episode_04_3d.png").exists()
-    assert "92.1" in stdout and "82.6" in stdout  # 004 Table I beside ours
-    assert f"{result.at(0).coverage_pct:.1f}" in stdout
+    assert "92.1" in stdout and "82.6" in stdout and "0.3" in stdout  # 004 Table I beside ours
+    row = result.at(4)
+    assert f"{row.coverage_pct:.1f}" in stdout
+    low, high = row.strict_coverage_ci
+    assert f"{row.strict_coverage_pct:.1f} [{low:.1f}-{high:.1f}]" in stdout
+    assert f"{row.crash_pct:.1f} [{row.crash_ci[0]:.1f}-{row.crash_ci[1]:.1f}]" in stdout
     page = (out / "report.html").read_text(encoding="utf-8")
     assert "plotly" in page and "004 Table I" in page
     pictures = len(list(out.glob("*.png")))
@@ -46,6 +54,8 @@ def test_show_draws_one_episode(capsys, tmp_path):
         (["--obstacles", "0,99"], "must lie in 0-60"),
         (["--episodes", "0"], "--episodes must be at least 1"),
         (["--policy", "greedy"], "unknown policy 'greedy'"),
+        (["--shapes", "cylinder,torus"], "unknown shape 'torus'"),
+        (["--shapes", "box,box"], "--shapes repeats a shape"),
     ],
 )
 def test_bad_input_is_one_line_and_exit_1(capsys, tmp_path, args, message):
@@ -75,7 +85,13 @@ def test_train_writes_a_checkpoint_that_eval_can_fly(capsys, tmp_path):
         "--episodes", "1", "--envs", "1", "--out", str(tmp_path / "eval"),
     )  # fmt: skip
     assert code == 0, err
-    assert EvaluationResult.from_json(tmp_path / "eval" / "evaluation.json").at(0).episodes == 1
+    result = EvaluationResult.from_json(tmp_path / "eval" / "evaluation.json")
+    assert result.at(0).episodes == 1
+    assert result.checkpoint_sha256 == file_sha256(run_dir / "checkpoint.pt")
+    from seminspect.missions.learning.checkpoints import read_checkpoint
+
+    trained = read_checkpoint(run_dir / "checkpoint.pt").env_config
+    assert result.config == evaluation_config(trained)  # what it saw in training, our rooms
 
 
 @pytest.mark.parametrize(

@@ -141,3 +141,16 @@ def test_a_file_rewritten_in_place_needs_no_room_for_a_copy(tmp_path, monkeypatc
     with pytest.raises(OSError, match="No space left") as raised:
         rewrite_in_place(path, b"again")
     assert raised.value.filename == str(path)
+
+
+def test_file_sha256_matches_hashlib_over_blocks_larger_than_one_read(tmp_path) -> None:
+    import hashlib
+
+    from seminspect.core.io import file_sha256
+
+    data = bytes(range(256)) * 5000  # 1.28 MB: more than one 1 MiB block
+    target = tmp_path / "weights.bin"
+    target.write_bytes(data)
+    assert file_sha256(target) == hashlib.sha256(data).hexdigest()
+    target.write_bytes(data[:-1])
+    assert file_sha256(target) != hashlib.sha256(data).hexdigest()

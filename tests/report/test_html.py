@@ -354,6 +354,10 @@ def test_rl_report_has_a_curve_per_obstacle_count_and_every_episode(rl_eval_dir:
     episodes = sum(row.episodes for row in result.results)
     assert layers["timeout (no crash)"] + layers["crashed"] == episodes
     assert "004 Table I" in page and "92.1" in page and "82.6" in page  # the paper beside ours
+    row = result.at(4)
+    low, high = row.crash_ci
+    assert f"{row.crash_pct:.1f} [{low:.1f}-{high:.1f}]" in page  # Wilson interval
+    assert "strict coverage" in page and "(a baseline)" in page  # no checkpoint digest
     assert page.count("data:image/jpeg;base64,") == 1  # coverage.png; no episode pictures here
 
 

@@ -4,13 +4,19 @@ import math
 
 import numpy as np
 import pytest
+from matplotlib.collections import PolyCollection
+from matplotlib.patches import Wedge
 
 from seminspect.missions.learning.baselines import OrbitController, RandomController
 from seminspect.missions.learning.env import EnvConfig
 from seminspect.missions.learning.evaluation import evaluate
 from seminspect.missions.learning.rooms import BOX, CYLINDER, TARGET_FACES
 from seminspect.report.rl import (
+    COVERED,
+    FAR,
+    UNSEEN,
     coverage_figure,
+    episode_top_down,
     face_states,
     solid_outline,
     write_episode_pictures,
@@ -56,9 +62,18 @@ def test_coverage_against_time_has_a_line_per_controller_and_a_panel_per_count(e
     results, _ = evaluations
     figure = coverage_figure(results)
     assert [ax.get_title() for ax in figure.axes] == ["0 obstacles", "4 obstacles"]
-    for ax in figure.axes:
-        assert [line.get_label() for line in ax.get_lines()] == ["orbit", "random"]
-        assert math.isclose(ax.get_ylim()[1], 100.0)
+    for ax, obstacles in zip(figure.axes, (0, 4), strict=True):
+        lines = [line for line in ax.get_lines() if not line.get_label().startswith("_")]
+        assert [line.get_label() for line in lines] == ["orbit", "random"]
+        # the strict curves, not the lenient ones
+        np.testing.assert_allclose(lines[0].get_ydata(), results["orbit"].at(obstacles).curve_mean)
+        assert lines[0].get_ydata()[-1] == pytest.approx(
+            results["orbit"].at(obstacles).strict_coverage_pct
+        )
+        feasible = [line.get_ydata()[0] for line in ax.get_lines() if line not in lines]
+        assert feasible == [95.0, 100.0]  # 004 Fig 5's lines
+        assert "feasible" in ax.get_ylabel()
+        assert math.isclose(ax.get_ylim()[1], 101.0)
 
 
 def test_training_curves_pool_the_episodes_of_each_run(tmp_path):
@@ -78,3 +93,25 @@ def test_training_curves_pool_the_episodes_of_each_run(tmp_path):
     )
     path = save_figure(training_figure({"run": log}, window=1), tmp_path / "training.png")
     assert path.stat().st_size > 0
+
+
+@pytest.mark.parametrize("shape", ["box", "t-pipe"])
+def test_the_top_down_view_draws_any_shape_by_its_faces_states(shape, tmp_path):
+    from matplotlib.colors import to_rgba
+
+    config = EnvConfig(episode_seconds=3.0, target_shapes=(shape,))
+    traces = {}
+    evaluate(OrbitController(), [4], 1, seed=0, config=config, num_envs=1, policy="orbit",
+             traces=traces)  # fmt: skip
+    trace, room = traces[4], traces[4].room
+    ax = episode_top_down(trace, config.inspect_range).axes[0]
+    (triangles,) = [c for c in ax.collections if isinstance(c, PolyCollection)]
+    assert len(triangles.get_paths()) == np.sum(room.face_of_triangle >= 0)
+    states = face_states(trace.face_distances, config.inspect_range)
+    palette = {tuple(to_rgba(c)) for c in np.array([UNSEEN, FAR, COVERED])[np.unique(states)]}
+    assert {tuple(c) for c in triangles.get_facecolors()} == palette
+    assert 1 <= len([p for p in ax.patches if isinstance(p, Wedge)]) <= 12
+    footprints = [p for p in ax.patches if not isinstance(p, Wedge)]
+    assert len(footprints) == 1 + room.obstacle_count  # the room's outline, then obstacles only
+    written = write_episode_pictures(trace, config, tmp_path, prefix=shape)
+    assert all(p.stat().st_size > 10_000 for p in written)

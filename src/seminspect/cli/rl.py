@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from seminspect.cli._common import console, existing_outputs, progress_bar
+
+if TYPE_CHECKING:
+    from seminspect.missions.learning.env_config import EnvConfig, TargetShape
 
 app = typer.Typer(no_args_is_help=True, help="Learned semantic inspection in rooms (004).")
 
@@ -89,23 +93,35 @@ def eval_command(
     seed: int = _SEED,
     envs: int = _ENVS,
     threads: int = _THREADS,
+    shapes: str = typer.Option(
+        "cylinder", "--shapes", help="Comma-separated object shapes: cylinder, box, sphere, t-pipe."
+    ),
     out: Path = typer.Option(
         ..., "--out", "-o", help="Directory for evaluation.json, report.html and PNGs."
     ),
 ) -> None:
-    """Coverage, crash % and timeout % per obstacle count, beside 004 Table I."""
+    """Coverage (lenient and strict), crash % and timeout % per obstacle count, beside 004
+    Table I; the policy flies with the observations of the environment it was trained in."""
     from seminspect.cli._common import writable_directory
     from seminspect.core.errors import InvalidInputError
-    from seminspect.missions.learning.evaluation import EpisodeTrace, evaluate
+    from seminspect.core.io import file_sha256
+    from seminspect.missions.learning.evaluation import (
+        EpisodeTrace,
+        controller_evaluation_config,
+        evaluate,
+    )
     from seminspect.report.figures import save_figure
     from seminspect.report.html import write_rl_report
     from seminspect.report.rl import coverage_figure, write_episode_pictures
 
     counts = parse_obstacles(obstacles)
+    objects = _parse_shapes(shapes)
     if episodes < 1:
         raise InvalidInputError(f"--episodes must be at least 1, got {episodes}")
     writable_directory(out)
     controller = controller_for(policy, seed)
+    config = controller_evaluation_config(controller, objects)
+    checkpoint = _checkpoint_file(policy)
     name = _policy_name(policy)
     traces: dict[int, EpisodeTrace] = {}
     with progress_bar() as bar:
@@ -119,11 +135,13 @@ def eval_command(
             counts,
             episodes,
             seed,
+            config=config,
             num_envs=envs,
             progress=show,
             policy=name,
             threads=threads,
             traces=traces,
+            checkpoint_sha256=None if checkpoint is None else file_sha256(checkpoint),
         )
     result.to_json(out / "evaluation.json")
     save_figure(coverage_figure({name: result}), out / "coverage.png")
@@ -142,21 +160,52 @@ def eval_command(
     console.print(f"{result.wall_seconds:.1f} s; results: {out}  ({outputs})", soft_wrap=True)
 
 
+def _parse_shapes(text: str) -> tuple[TargetShape, ...]:
+    """``"cylinder,box"`` -> ``("cylinder", "box")``: known, distinct object shapes."""
+    from seminspect.core.errors import InvalidInputError
+    from seminspect.missions.learning.env_config import TARGET_SHAPES
+
+    names = [part.strip() for part in text.split(",")]
+    if unknown := [s for s in names if s not in TARGET_SHAPES]:
+        raise InvalidInputError(
+            f"--shapes: unknown shape {unknown[0]!r}; use some of {', '.join(TARGET_SHAPES)}"
+        )
+    if len(set(names)) != len(names):
+        raise InvalidInputError(f"--shapes repeats a shape: {text!r}")
+    return tuple(shape for name in names for shape in TARGET_SHAPES if shape == name)
+
+
+def _checkpoint_file(policy: str | None) -> Path | None:
+    """The checkpoint file a policy flies (the shipped one for None); None for a baseline."""
+    if policy in BASELINES:
+        return None
+    from seminspect.missions.learning.agent import shipped_policy_path
+
+    return shipped_policy_path() if policy is None else Path(policy)
+
+
 def _print_table(result) -> None:
+    """Ours beside 004 Table I; timeouts are left out (100 % - crashes) to fit 80 columns."""
     from rich.table import Table
 
-    from seminspect.missions.learning.evaluation import PAPER_TABLE1
+    from seminspect.missions.learning.evaluation import PAPER_TABLE1, interval_text
 
-    table = Table(title=f"{result.policy}: {result.results[0].episodes} episodes per row")
-    for header in ("obstacles", "coverage %", "004", "crash %", "004", "timeout %", "004"):
+    shapes = ", ".join(result.config.target_shapes)
+    title = f"{result.policy} ({shapes}): {result.results[0].episodes} episodes per row"
+    caption = "strict: % of the feasible faces; [ ]: 95 % interval; timeout % = 100 - crash %"
+    table = Table(title=title, caption=caption)
+    for header in ("obstacles", "coverage %", "strict %", "004", "crash %", "004"):
         table.add_column(header, justify="right")
     for row in result.results:
         paper = PAPER_TABLE1.get(row.obstacles)
-        ours = (row.coverage_pct, row.crash_pct, row.timeout_pct)
-        cells = [str(row.obstacles)]
-        for k, value in enumerate(ours):
-            cells += [f"{value:.1f}", "-" if paper is None else f"{paper[k]:.1f}"]
-        table.add_row(*cells)
+        table.add_row(
+            str(row.obstacles),
+            f"{row.coverage_pct:.1f}",
+            interval_text(row.strict_coverage_pct, row.strict_coverage_ci),
+            "-" if paper is None else f"{paper[0]:.1f}",
+            interval_text(row.crash_pct, row.crash_ci),
+            "-" if paper is None else f"{paper[1]:.1f}",
+        )
     console.print(table)
 
 
@@ -167,15 +216,16 @@ def show_command(
     seed: int = _SEED,
     out: Path = typer.Option(..., "--out", "-o", help="Directory for the episode's PNGs."),
 ) -> None:
-    """Fly one recorded episode and draw it (top-down, 3D, coverage against time)."""
+    """Fly one recorded episode in the rooms the policy was trained in and draw it (top-down,
+    3D, coverage against time)."""
     from seminspect.cli._common import writable_directory
-    from seminspect.missions.learning.env import EnvConfig, InspectionVectorEnv
+    from seminspect.missions.learning.env import InspectionVectorEnv
     from seminspect.missions.learning.evaluation import EpisodeTrace
     from seminspect.report.rl import write_episode_pictures
 
     writable_directory(out)
     controller = controller_for(policy, seed)
-    config = EnvConfig(obstacles=obstacles)
+    config = env_config_for(controller).model_copy(update={"obstacles": obstacles})
     env = InspectionVectorEnv(1, config, seed=seed, autoreset=False, record=True)
     obs, _ = env.reset(seed=seed)
     controller.reset(env)
@@ -196,8 +246,22 @@ def show_command(
     console.print(f"pictures: {', '.join(str(p) for p in written)}")
 
 
+def env_config_for(controller: object) -> EnvConfig:
+    """The environment a controller was trained in (a checkpoint's ``env_config``); a
+    baseline, trained in none, gets the defaults."""
+    from seminspect.missions.learning.env_config import EnvConfig
+
+    config = getattr(controller, "env_config", None)
+    return config if isinstance(config, EnvConfig) else EnvConfig()
+
+
+#: Options that set up a new run: with --resume the saved run's own settings hold.
+_NEW_RUN_OPTIONS = ("config", "variant", "steps", "seed", "envs", "device", "out")
+
+
 @app.command("train")
 def train_command(
+    ctx: typer.Context,
     config: str = typer.Option(
         "small", "--config", help="Network: small (sized for a CPU) or paper (004 Fig 2)."
     ),
@@ -208,22 +272,68 @@ def train_command(
     seed: int = _SEED,
     envs: int = typer.Option(64, "--envs", help="Rooms stepped together.", min=1, max=512),
     device: str = typer.Option("cpu", "--device", help="Torch device for the network (cpu, cuda)."),
-    out: Path = typer.Option(..., "--out", "-o", help="Directory for checkpoint.pt and logs."),
+    out: Path | None = typer.Option(
+        None, "--out", "-o", help="Directory for checkpoint.pt, training-state.pt and the logs."
+    ),
+    resume: Path | None = typer.Option(
+        None,
+        "--resume",
+        help="Continue the run in this directory from its last saved state, with its settings.",
+    ),
+    max_minutes: float | None = typer.Option(
+        None,
+        "--max-minutes",
+        min=0.0,
+        help="Stop at the first update boundary after this many minutes, state saved.",
+    ),
 ) -> None:
-    """Train a policy with recurrent PPO and the obstacle curriculum; Ctrl-C keeps a checkpoint."""
-    from seminspect.cli._common import writable_directory
+    """Train a policy with recurrent PPO and the obstacle curriculum, in pieces if need be:
+    --max-minutes, Ctrl-C or SIGTERM save the state, --resume continues it."""
     from seminspect.core.errors import InvalidInputError
+
+    _require_torch()
+    stop_after_s = None if max_minutes is None else 60.0 * max_minutes
+    if resume is not None:
+        given = [name for name in _NEW_RUN_OPTIONS if _given(ctx, name)]
+        if given:
+            options = ", ".join(f"--{name}" for name in given)
+            raise InvalidInputError(
+                f"--resume continues a run with its own settings; drop {options}"
+            )
+        _resume_run(resume, stop_after_s)
+        return
+    if out is None:
+        raise InvalidInputError("--out is needed for a new run (or --resume DIR to continue one)")
+    if steps < 1:
+        raise InvalidInputError(f"--steps must be at least 1, got {steps}")
+    _new_run(config, variant, steps, seed, envs, device, out, stop_after_s)
+
+
+def _given(ctx: typer.Context, name: str) -> bool:
+    # by name: typer's own click has its own ParameterSource enum
+    source = ctx.get_parameter_source(name)
+    return source is not None and source.name not in ("DEFAULT", "DEFAULT_MAP")
+
+
+def _new_run(
+    config: str,
+    variant: str,
+    steps: int,
+    seed: int,
+    envs: int,
+    device: str,
+    out: Path,
+    stop_after_s: float | None,
+) -> None:
+    from seminspect.cli._common import writable_directory
     from seminspect.missions.learning.env import InspectionVectorEnv
-    from seminspect.missions.learning.ppo import ProgressRow, train
+    from seminspect.missions.learning.ppo import train
     from seminspect.missions.learning.recipes import (
         policy_config,
         train_config,
         training_env_config,
     )
 
-    if steps < 1:
-        raise InvalidInputError(f"--steps must be at least 1, got {steps}")
-    _require_torch()
     _check_device(device)
     network = policy_config(config, variant)  # type: ignore[arg-type]
     settings = train_config(steps, seed=seed, num_envs=envs)
@@ -233,18 +343,80 @@ def train_command(
     def make_env(count: int, env_seed: int) -> InspectionVectorEnv:
         return InspectionVectorEnv(count, rooms, seed=env_seed)
 
+    def run(progress):
+        return train(
+            make_env,
+            network,
+            settings,
+            out,
+            env_config=rooms,
+            progress=progress,
+            device=device,
+            stop_after_s=stop_after_s,
+        )
+
+    _train_with_bar(f"{config}/{variant}", settings.total_steps, out, run)
+
+
+def _resume_run(run_dir: Path, stop_after_s: float | None) -> None:
+    from seminspect.missions.learning.ppo import resume
+    from seminspect.missions.learning.training_state import (
+        TRAINING_STATE_NAME,
+        read_training_state,
+    )
+
+    state = read_training_state(run_dir / TRAINING_STATE_NAME)
+    total = state.train_config.total_steps
+    if state.finished:
+        console.print(
+            f"{run_dir}: the run is finished ({state.steps:,} of {total:,} steps); "
+            "nothing to resume",
+            soft_wrap=True,
+        )
+        return
+    _check_device(state.device)
+
+    def run(progress):
+        return resume(state, run_dir, progress=progress, stop_after_s=stop_after_s)
+
+    _train_with_bar(f"{run_dir.name}, from step {state.steps:,}", total, run_dir, run)
+
+
+def _train_with_bar(label: str, total: int, run_dir: Path, run) -> None:
+    """``run(progress)`` under a progress bar, then the line that says how it ended."""
+    from seminspect.cli._common import err_console
+    from seminspect.core.interrupts import as_interrupted
+    from seminspect.missions.learning.ppo import ProgressRow
+    from seminspect.missions.learning.training_state import TRAINING_STATE_NAME
+
+    again = f"continue with: seminspect rl train --resume {run_dir}"
     with progress_bar() as bar:
-        task = bar.add_task(f"{config}/{variant}", total=steps)
+        task = bar.add_task(label, total=total)
 
         def show(row: ProgressRow) -> None:
             coverage = "" if row.episodes == 0 else f", coverage {row.coverage_pct:.0f} %"
-            label = f"{config}/{variant}: {row.steps_per_s:.0f} steps/s{coverage}"
-            bar.update(task, completed=min(row.steps, steps), description=label)
+            text = f"{label}: {row.steps_per_s:.0f} steps/s{coverage}"
+            bar.update(task, completed=min(row.steps, total), description=text)
 
-        result = train(make_env, network, settings, out, progress=show, device=device)
+        try:
+            result = run(show)
+        except KeyboardInterrupt as exc:
+            if not (run_dir / TRAINING_STATE_NAME).is_file():
+                raise
+            stop = as_interrupted(exc)
+            err_console.print(f"{stop.describe()}; {again}", highlight=False, soft_wrap=True)
+            raise typer.Exit(stop.exit_code) from None
+    minutes = result.wall_s / 60
+    if not result.finished:  # unwrapped: the command is copied from this line
+        console.print(
+            f"stopped at step {result.steps:,} of {total:,} after {minutes:.1f} min; {again}",
+            soft_wrap=True,
+        )
+        return
     console.print(
-        f"{result.steps:,} steps in {result.wall_s / 60:.1f} min; "
-        f"checkpoint: {result.checkpoint} (progress.csv beside it)"
+        f"{result.steps:,} steps in {minutes:.1f} min; "
+        f"checkpoint: {result.checkpoint} (progress.csv beside it)",
+        soft_wrap=True,
     )
 
 

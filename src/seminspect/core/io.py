@@ -12,6 +12,7 @@ reader can refuse a file of another kind or a version it does not understand wit
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import io
 import json
 import math
@@ -242,3 +243,12 @@ def read_yaml(path: str | os.PathLike[str]) -> Any:
         return yaml.safe_load(text)
     except yaml.YAMLError as exc:
         raise FileFormatError(f"{path}: malformed YAML: {str(exc).splitlines()[0]}") from None
+
+
+def file_sha256(path: str | os.PathLike[str]) -> str:
+    """Hex SHA-256 of a file's bytes, read in blocks (e.g. the checkpoint an evaluation used)."""
+    digest = hashlib.sha256()
+    with Path(path).open("rb") as stream:
+        for block in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()

@@ -1,8 +1,9 @@
 """``report.html`` of an ``rl eval`` directory (004): coverage over time, outcomes, episodes.
 
-Drawn from ``evaluation.json`` alone (and the PNGs beside it): the mean coverage against time
-per obstacle count with its 5th-95th percentile band (004 Fig 5), every episode's final
-coverage, the table beside 004 Table I, one row per episode, and the evaluation's pictures.
+Drawn from ``evaluation.json`` alone (and the PNGs beside it): the mean strict coverage (of the
+feasible faces) against time per obstacle count with its 5th-95th percentile band (004 Fig 5),
+every episode's final strict coverage, the table beside 004 Table I (lenient and strict
+coverage, crash % with its 95 % interval), one row per episode, and the evaluation's pictures.
 """
 
 from __future__ import annotations
@@ -12,7 +13,12 @@ from pathlib import Path
 
 import plotly.graph_objects as go
 
-from seminspect.missions.learning.evaluation import PAPER_TABLE1, EvaluationResult, ObstacleResult
+from seminspect.missions.learning.evaluation import (
+    PAPER_TABLE1,
+    EvaluationResult,
+    ObstacleResult,
+    interval_text,
+)
 from seminspect.report.html_page import (
     REPORT_FILE,
     Section,
@@ -55,6 +61,8 @@ def write_rl_report(run_dir: str | os.PathLike[str]) -> Path:
 def _facts(result: EvaluationResult) -> dict[str, object]:
     return {
         "policy": result.policy,
+        "checkpoint SHA-256": result.checkpoint_sha256 or "(a baseline)",
+        "object shapes": list(result.config.target_shapes),
         "seed": result.seed,
         "rooms stepped together": result.num_envs,
         "obstacle counts": [row.obstacles for row in result.results],
@@ -66,30 +74,44 @@ def _facts(result: EvaluationResult) -> dict[str, object]:
 def _table1(result: EvaluationResult) -> str:
     rows = []
     for row in result.results:
-        paper = PAPER_TABLE1.get(row.obstacles)
-        cells: list[object] = [row.obstacles, row.episodes]
-        for k, ours in enumerate((row.coverage_pct, row.crash_pct, row.timeout_pct)):
-            cells += [round(ours, 1), None if paper is None else paper[k]]
-        rows.append(cells)
-    headers = ("obstacles", "episodes", "coverage %", "004", "crash %", "004", "timeout %", "004")
-    return rows_table(headers, rows) + "<p>004: the paper's trained policy (Table I).</p>"
+        published = PAPER_TABLE1.get(row.obstacles)
+        paper = [None] * 3 if published is None else [f"{v:.1f}" for v in published]
+        rows.append([
+            row.obstacles, row.episodes, f"{row.coverage_pct:.1f}",
+            interval_text(row.strict_coverage_pct, row.strict_coverage_ci), paper[0],
+            f"{row.distance_score:.2f}", interval_text(row.crash_pct, row.crash_ci), paper[1],
+            f"{row.timeout_pct:.1f}", paper[2],
+        ])  # fmt: skip
+    headers = (
+        "obstacles", "episodes", "coverage %", "strict coverage %", "004", "distance score",
+        "crash %", "004", "timeout %", "004",
+    )  # fmt: skip
+    return rows_table(headers, rows) + (
+        "<p>004: the paper's trained policy (Table I). Coverage: lenient, faces seen within "
+        "the inspection range; strict, the feasible faces seen by the strict rule. "
+        "[ ]: 95 % interval (Student's t; Wilson for crashes).</p>"
+    )
 
 
 def _episodes_table(result: EvaluationResult) -> str:
     rows = [
-        (row.obstacles, index + 1, round(coverage, 1), "crashed" if crashed else "timeout",
-         length, room)
+        (row.obstacles, index + 1, round(coverage, 1), round(strict, 1), feasible,
+         "crashed" if crashed else "timeout", length, room)
         for row in result.results
-        for index, (coverage, crashed, length, room) in enumerate(
-            zip(row.coverage, row.crashed, row.length, row.rooms, strict=True)
+        for index, (coverage, strict, feasible, crashed, length, room) in enumerate(
+            zip(row.coverage, row.strict_coverage, row.feasible_faces, row.crashed, row.length,
+                row.rooms, strict=True)
         )
     ]  # fmt: skip
-    headers = ("obstacles", "episode", "final coverage %", "ended", "steps", "room")
+    headers = (
+        "obstacles", "episode", "coverage %", "strict coverage %", "feasible faces", "ended",
+        "steps", "room",
+    )  # fmt: skip
     return rows_table(headers, rows)
 
 
 def coverage_plot(result: EvaluationResult):
-    """Mean coverage against time per obstacle count, with its 5th-95th percentile band."""
+    """Mean strict coverage against time per obstacle count, with its 5th-95th percentile band."""
     figure = go.Figure()
     for index, row in enumerate(result.results):
         colour = _COLOURS[index % len(_COLOURS)]
@@ -103,8 +125,9 @@ def coverage_plot(result: EvaluationResult):
             )
         )  # fmt: skip
     figure.update_layout(
-        title=f"{result.policy}: coverage over the episode (band: 5th-95th percentile)",
-        xaxis_title="time [s]", yaxis_title="coverage [%]", yaxis={"range": [0, 100]},
+        title=f"{result.policy}: strict coverage over the episode (band: 5th-95th percentile)",
+        xaxis_title="time [s]", yaxis_title="strict coverage [% of feasible faces]",
+        yaxis={"range": [0, 100]},
         height=480,
     )  # fmt: skip
     return figure
@@ -121,19 +144,19 @@ def _band_trace(row: ObstacleResult, colour: str):
 
 
 def outcome_plot(result: EvaluationResult):
-    """Every episode's final coverage per obstacle count; crashed episodes as crosses."""
+    """Every episode's final strict coverage per obstacle count; crashed episodes as crosses."""
     figure = go.Figure()
     for ended, symbol in ((False, "circle"), (True, "x")):
         xs, ys, hover = [], [], []
         for row in result.results:
             for index, (coverage, crashed) in enumerate(
-                zip(row.coverage, row.crashed, strict=True)
+                zip(row.strict_coverage, row.crashed, strict=True)
             ):
                 if crashed is ended:
                     xs.append(row.obstacles)
                     ys.append(coverage)
                     hover.append(
-                        f"{row.obstacles} obstacles, episode {index + 1}: {coverage:.1f} %"
+                        f"{row.obstacles} obstacles, episode {index + 1}: {coverage:.1f} % strict"
                     )
         name = "crashed" if ended else "timeout (no crash)"
         figure.add_trace(
@@ -144,7 +167,7 @@ def outcome_plot(result: EvaluationResult):
             )
         )  # fmt: skip
     figure.update_layout(
-        title="Final coverage of every episode", xaxis_title="obstacles",
-        yaxis_title="coverage [%]", yaxis={"range": [0, 100]}, height=420,
+        title="Final strict coverage of every episode", xaxis_title="obstacles",
+        yaxis_title="strict coverage [%]", yaxis={"range": [0, 100]}, height=420,
     )  # fmt: skip
     return figure

@@ -12,6 +12,7 @@ from seminspect.missions.learning.agent import (
     load_controller,
     shipped_policy_path,
 )
+from seminspect.missions.learning.checkpoints import save_checkpoint
 from seminspect.missions.learning.env import EnvConfig, InspectionVectorEnv
 from seminspect.missions.learning.policy import InspectionPolicy, PolicyConfig
 
@@ -30,7 +31,7 @@ def _rollout(controller: LearnedController, steps: int = 5) -> list[np.ndarray]:
 
 def test_learned_controller_acts_in_range_and_repeats_itself() -> None:
     torch.manual_seed(0)
-    controller = LearnedController(InspectionPolicy(PolicyConfig.small()))
+    controller = LearnedController(InspectionPolicy(PolicyConfig.small()), EnvConfig())
     first, second = _rollout(controller), _rollout(controller)
     assert first[0].shape == (3, 4)
     assert all(np.all(np.abs(a) <= 1.0) for a in first)
@@ -47,15 +48,25 @@ def test_shipped_policy_is_in_the_package() -> None:
     assert path.is_file(), path
     controller = load_controller()
     assert controller.policy.config == PolicyConfig.small()
+    assert controller.env_config == EnvConfig.legacy()  # policy v1 recorded no rooms
+
+
+def test_a_controller_flies_in_the_rooms_its_checkpoint_records(tmp_path) -> None:
+    rooms = EnvConfig(obstacles=5, target_shapes=("sphere",), use_svs=False)
+    torch.manual_seed(0)
+    policy = InspectionPolicy(PolicyConfig.small(use_svs=False))
+    path = save_checkpoint(tmp_path / "p.pt", policy, None, steps=0, env_config=rooms)
+    assert load_controller(path).env_config == rooms
 
 
 def test_shipped_policy_covers_far_more_than_random_in_the_same_rooms() -> None:
-    """Four fixed empty rooms, the paper's 90 s episodes: learned against random actions."""
+    """Four fixed empty rooms of its own kind, 90 s episodes: learned against random actions."""
     from seminspect.missions.learning.baselines import RandomController
     from seminspect.missions.learning.evaluation import evaluate
 
-    config = EnvConfig()
-    learned = evaluate(load_controller(), [0], 4, 11, config=config, num_envs=4).at(0)
+    controller = load_controller()
+    config = controller.env_config
+    learned = evaluate(controller, [0], 4, 11, config=config, num_envs=4).at(0)
     random = evaluate(RandomController(11), [0], 4, 11, config=config, num_envs=4).at(0)
     assert learned.rooms == random.rooms
     assert learned.coverage_pct > random.coverage_pct + 30.0

@@ -1,12 +1,25 @@
-"""The 004 Sec IV-A protocol: exact episode counts, shared rooms, outcome rates, JSON."""
+"""The 004 Sec IV-A protocol: exact episode counts, shared rooms, strict coverage, intervals,
+JSON."""
+
+import json
 
 import numpy as np
 import pytest
 
 from seminspect.core.errors import FileFormatError, InvalidInputError
+from seminspect.missions.learning import evaluation as evaluation_module
 from seminspect.missions.learning.baselines import OrbitController, RandomController
 from seminspect.missions.learning.env import EnvConfig
-from seminspect.missions.learning.evaluation import EvaluationResult, batch_seed, evaluate
+from seminspect.missions.learning.evaluation import (
+    PROTOCOL_ROOMS,
+    EvaluationResult,
+    batch_seed,
+    evaluate,
+    evaluation_config,
+    interval_text,
+    mean_interval_pct,
+    wilson_pct,
+)
 
 SHORT = EnvConfig(episode_seconds=3.0)
 
@@ -31,13 +44,85 @@ def test_every_obstacle_count_runs_exactly_the_episodes_asked(runs):
         assert len(set(row.rooms)) == 5  # five different rooms (3 batches of 2, 2, 1)
         assert row.crash_pct + row.timeout_pct == pytest.approx(100.0)
         assert row.crash_pct == pytest.approx(100.0 * np.mean(row.crashed))
+        assert row.crash_ci[0] <= row.crash_pct <= row.crash_ci[1]
+        assert row.timeout_ci == pytest.approx((100 - row.crash_ci[1], 100 - row.crash_ci[0]))
         assert row.coverage_pct == pytest.approx(np.mean(row.coverage))
+        assert row.strict_coverage_pct == pytest.approx(np.mean(row.strict_coverage))
+        low, high = row.strict_coverage_ci
+        assert 0.0 <= low <= row.strict_coverage_pct <= high <= 100.0
+        assert 0.0 <= row.distance_score <= 1.0 and len(row.distance_scores) == 5
         crashed_lengths = np.array(row.length)[np.array(row.crashed)]
         assert np.all(crashed_lengths <= SHORT.steps_per_episode)
         assert len(row.curve_mean) == len(row.curve_times) == 4  # 0, 1, 2, 3 s
         assert np.all(np.diff(row.curve_mean) >= 0)  # coverage never falls
-        assert row.curve_mean[-1] == pytest.approx(row.coverage_pct)
+        assert row.curve_mean[-1] == pytest.approx(row.strict_coverage_pct)  # strict curves
     assert shares == sorted(shares) and shares[-1] == pytest.approx(1.0)
+
+
+def test_strict_coverage_is_a_share_of_the_feasible_faces(runs):
+    orbit, random, _, _ = runs
+    side = 12 * 4  # a cylinder's 12 sectors x 4 bands; none of the 12 top faces
+    for row in (orbit.at(0), random.at(0)):
+        # an empty room: the whole side is feasible, the top is not (a level camera) and the
+        # strict rule cannot see it either
+        assert row.feasible_faces == [side] * row.episodes
+    for row in (*orbit.results, *random.results):
+        seen = np.array(row.strict_coverage) * np.array(row.feasible_faces) / 100.0
+        np.testing.assert_allclose(seen, np.round(seen), atol=1e-9)  # whole faces
+        assert all(0 < n <= 60 for n in row.feasible_faces)
+    assert orbit.at(0).strict_coverage_pct > random.at(0).strict_coverage_pct
+
+
+def test_a_face_seen_strictly_counts_as_feasible(monkeypatch):
+    """Were no face found feasible, the strictly seen faces would still be scored."""
+    truth = evaluate(OrbitController(), [0], 2, seed=1, config=SHORT, num_envs=2).at(0)
+    shares = zip(truth.strict_coverage, truth.feasible_faces, strict=True)
+    seen = [round(share * count / 100) for share, count in shares]
+    assert max(seen) > 0  # the orbit sees some faces strictly within 3 s
+    monkeypatch.setattr(
+        evaluation_module, "feasible_faces", lambda room, config, seed: np.zeros(60, dtype=bool)
+    )
+    row = evaluate(OrbitController(), [0], 2, seed=1, config=SHORT, num_envs=2).at(0)
+    assert row.feasible_faces == seen
+    assert row.strict_coverage == [100.0, 100.0]  # seen / seen, or nothing to see
+
+
+def test_intervals_come_from_wilson_and_student():
+    assert wilson_pct([False] * 5) == pytest.approx((0.0, 43.448), abs=1e-3)
+    assert wilson_pct([True, False]) == pytest.approx((9.453, 90.547), abs=1e-3)
+    assert mean_interval_pct([40.0, 50.0, 60.0, 45.0, 55.0]) == pytest.approx(
+        (40.184, 59.816), abs=1e-3
+    )
+    assert mean_interval_pct([70.0, 70.0]) == (70.0, 70.0)
+    assert mean_interval_pct([30.0]) == (0.0, 100.0)  # one episode says nothing of the spread
+    assert mean_interval_pct([0.0, 100.0])[0] == 0.0  # clipped to the percentage range
+    assert interval_text(56.24, (48.0, 64.44)) == "56.2 [48.0-64.4]"
+
+
+def test_the_protocol_fixes_the_rooms_and_keeps_what_the_policy_sees():
+    legacy = EnvConfig.legacy(episode_seconds=45.0, room_size=(8.0, 8.0, 3.0), obstacles=3)
+    config = evaluation_config(legacy, ("box", "sphere"))
+    for key, value in PROTOCOL_ROOMS.items():
+        assert getattr(config, key) == value
+    assert config.target_shapes == ("box", "sphere")
+    assert (config.ego_map, config.yaw_encoding, config.face_reward) == (
+        "binary", "half-angle", "repaid",
+    )  # fmt: skip
+    assert evaluation_config(EnvConfig()).target_shapes == ("cylinder",)
+    with pytest.raises(InvalidInputError, match="evaluation environment"):
+        evaluation_config(EnvConfig(), ("torus",))  # type: ignore[arg-type]
+
+
+def test_policies_trained_in_other_environments_meet_the_same_rooms():
+    """The rooms follow the protocol and the seed, not what each policy sees or is paid."""
+    short = {"episode_seconds": 1.0}
+    new = evaluation_config(EnvConfig()).model_copy(update=short)
+    old = evaluation_config(EnvConfig.legacy()).model_copy(update=short)
+    assert new != old
+    a = evaluate(RandomController(), [4], 2, seed=3, config=new, num_envs=2)
+    b = evaluate(RandomController(), [4], 2, seed=3, config=old, num_envs=2)
+    assert a.at(4).rooms == b.at(4).rooms
+    assert a.at(4).feasible_faces == b.at(4).feasible_faces
 
 
 def test_two_controllers_meet_the_same_rooms(runs):
@@ -60,12 +145,40 @@ def test_the_first_episode_of_each_count_is_traced(runs):
 
 def test_the_result_round_trips_through_json(runs, tmp_path):
     orbit = runs[0]
+    assert orbit.checkpoint_sha256 is None  # a baseline
     path = orbit.to_json(tmp_path / "evaluation.json")
     assert EvaluationResult.from_json(path) == orbit
-    assert '"coverage_pct"' in path.read_text()
+    assert '"strict_coverage_pct"' in path.read_text()
     path.write_text(path.read_text().replace('"episodes"', '"runs"', 1))
     with pytest.raises(FileFormatError, match="evaluation"):
         EvaluationResult.from_json(path)
+
+
+def test_the_checkpoint_digest_is_kept_and_feasibility_is_decided_once_per_room(
+    monkeypatch, tmp_path
+):
+    calls = []
+    real = evaluation_module.feasible_faces
+    monkeypatch.setattr(
+        evaluation_module, "feasible_faces", lambda *args: calls.append(1) or real(*args)
+    )
+    digest = "ab" * 32
+    result = evaluate(
+        RandomController(), [0, 4], 3, seed=0, config=SHORT, num_envs=2, checkpoint_sha256=digest
+    )
+    assert len(calls) == 6  # 2 counts x 3 rooms, however many steps
+    path = result.to_json(tmp_path / "evaluation.json")
+    assert EvaluationResult.from_json(path).checkpoint_sha256 == digest
+
+
+def test_a_version_1_file_is_refused_with_how_to_regenerate_it(runs, tmp_path):
+    path = runs[0].to_json(tmp_path / "evaluation.json")
+    document = json.loads(path.read_text())
+    path.write_text(json.dumps(document | {"version": 1}))
+    with pytest.raises(FileFormatError, match="version-1") as error:
+        EvaluationResult.from_json(path)
+    assert "bench/rl_reproduction.py" in str(error.value)
+    assert len(str(error.value).splitlines()) == 1
 
 
 @pytest.mark.parametrize(

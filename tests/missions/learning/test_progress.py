@@ -6,6 +6,7 @@ import csv
 import dataclasses
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -32,7 +33,8 @@ def test_the_log_rewrites_progress_csv_with_blank_cells_for_nothing(tmp_path: Pa
     log = ProgressLog(tmp_path)
     try:
         for update in (1, 2):
-            values = dict.fromkeys(names, 0.5) | {"update": update, "steps": 10 * update}
+            values: dict[str, Any] = dict.fromkeys(names, 0.5)
+            values |= {"update": update, "steps": 10 * update}
             log.add(ProgressRow(**values | {"obstacles": None, "mean_return": math.nan}))
     finally:
         log.close()
@@ -41,3 +43,21 @@ def test_the_log_rewrites_progress_csv_with_blank_cells_for_nothing(tmp_path: Pa
     assert [row["steps"] for row in rows] == ["10", "20"]
     assert rows[0]["obstacles"] == "" and rows[0]["mean_return"] == ""
     assert rows[1]["lr"] == "0.5"
+
+
+def test_a_resumed_log_goes_on_from_the_saved_rows_not_the_file(tmp_path: Path):
+    names = [field.name for field in dataclasses.fields(ProgressRow)]
+
+    def row(update: int) -> ProgressRow:
+        values: dict[str, Any] = dict.fromkeys(names, 0.5)
+        return ProgressRow(**values | {"update": update, "steps": update})
+
+    first = ProgressLog(tmp_path)
+    for update in (1, 2, 3):  # 3 was logged after the last saved state
+        first.add(row(update))
+    first.close()
+    resumed = ProgressLog(tmp_path, first.rows[:2])
+    resumed.add(row(3))
+    resumed.close()
+    with (tmp_path / "progress.csv").open() as handle:
+        assert [int(r["update"]) for r in csv.DictReader(handle)] == [1, 2, 3]

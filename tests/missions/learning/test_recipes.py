@@ -5,8 +5,9 @@ from __future__ import annotations
 import pytest
 
 from seminspect.core.errors import InvalidInputError
+from seminspect.missions.learning.env_config import PAPER_ROOM_RANGE, TARGET_SHAPES
 from seminspect.missions.learning.recipes import (
-    TRAINING_EPISODE_SECONDS,
+    BUDGETS,
     VARIANTS,
     policy_config,
     train_config,
@@ -23,11 +24,19 @@ def test_variants_ablate_one_part_each() -> None:
     assert set(VARIANTS) == {"main", "no-svs", "no-gru"}
 
 
-def test_training_rooms_follow_the_network() -> None:
+def test_training_rooms_are_004s_and_follow_the_network() -> None:
     env = training_env_config(policy_config("small", "no-svs"))
     assert not env.use_svs
-    assert env.episode_seconds == TRAINING_EPISODE_SECONDS
     assert training_env_config(policy_config()).use_svs
+    # 004 Sec III-E: rooms of [4, 20] x [4, 20] x [2, 8] m, 90 s episodes, primitive objects
+    assert env.room_size_range == PAPER_ROOM_RANGE and env.episode_seconds == 90.0
+    assert set(env.target_shapes) == set(TARGET_SHAPES) - {"t-pipe"}  # held out, as in Sec V
+    assert env.face_reward == "fraction" and env.yaw_encoding == "full-angle"  # not policy v1's
+
+
+def test_the_budgets_are_5_m_steps_for_the_policy_and_2_m_per_ablation() -> None:
+    assert BUDGETS == {"main": 5_000_000, "no-svs": 2_000_000, "no-gru": 2_000_000}
+    assert set(BUDGETS) == set(VARIANTS)
 
 
 def test_only_budget_and_seed_vary_between_runs() -> None:

@@ -1,4 +1,5 @@
-"""The reward terms of 004 eq (6) by hand: f_t's face scores, v_t and p_t."""
+"""The reward terms of 004 eq (6) by hand: f_t's face scores (repaid and fraction), v_t and
+p_t (binary and graded)."""
 
 import math
 
@@ -7,8 +8,12 @@ import pytest
 
 from seminspect.missions.learning.rewards import (
     collision_penalty,
+    distance_score,
     face_scores,
+    graded_penalty,
+    inspected_fraction,
     semantic_search_reward,
+    updated_best,
 )
 
 D_REF, ALPHA, BETA = 1.5, 0.15, 1.0
@@ -49,3 +54,47 @@ def test_semantic_search_reward_is_eq_10():
 def test_the_collision_penalty_is_minus_one_for_any_occupied_near_cell():
     near = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 1.0]], dtype=np.float32)
     np.testing.assert_array_equal(collision_penalty(near), [0.0, -1.0, -1.0])
+    # unknown cells (0.5 in the three-state map) are not occupied
+    assert collision_penalty(np.full((1, 3), 0.5, dtype=np.float32))[0] == 0.0
+
+
+def test_the_graded_penalty_is_minus_one_within_d_coll_and_falls_linearly_to_reach():
+    distance = np.array([0.1, 0.3, 0.4, 0.5, 0.6])  # the cells' distances from the robot
+    rows = np.zeros((5, 5), dtype=np.float32)
+    rows[np.arange(5), np.arange(5)] = 1.0  # row i: only cell i occupied
+    penalty = graded_penalty(rows, distance, d_coll=0.3, reach=0.6)
+    np.testing.assert_allclose(penalty, [-1.0, -1.0, -2.0 / 3.0, -1.0 / 3.0, 0.0], atol=1e-12)
+    # the nearest occupied cell decides; unknown (0.5) and free cells do not count
+    mixed = np.array([[0.5, 0.5, 1.0, 0.0, 1.0]], dtype=np.float32)
+    assert graded_penalty(mixed, distance, 0.3, 0.6)[0] == pytest.approx(-2.0 / 3.0)
+    assert graded_penalty(np.zeros((1, 5)), distance, 0.3, 0.6)[0] == 0.0
+    # reach == d_coll: a step
+    np.testing.assert_array_equal(graded_penalty(rows, distance, 0.3, 0.3), [-1, -1, 0, 0, 0])
+
+
+def test_the_distance_score_is_eq_7s_weight_and_zero_for_never_seen():
+    score = distance_score(np.array([D_REF, D_REF + 1.0, np.inf]), D_REF, BETA)
+    np.testing.assert_allclose(score, [1.0, math.exp(-BETA), 0.0])
+
+
+def test_the_fraction_form_pays_the_distance_weighted_fraction_so_far_at_every_step():
+    """f_t = (1/N_f) sum_f s(d_f) with d_f kept by eq (8): in [0, 1], never falling."""
+    views = [  # mean distances of 3 faces over 4 steps (nan: not in view)
+        [3.5, np.nan, 0.2],
+        [2.5, 4.0, np.nan],
+        [3.0, 1.0, 1.4],  # face 0 farther than its best: d_f stays 2.5
+        [1.5, 1.8, 1.6],  # face 2: |0.1| is not < |-0.1|: d_f stays 1.4
+    ]
+    best = np.full((1, 3), np.inf)
+    paid = []
+    for distance in views:
+        best = updated_best(np.array([distance]), best, D_REF)
+        paid.append(float(inspected_fraction(best, D_REF, BETA)[0]))
+    np.testing.assert_array_equal(best[0], [1.5, 1.8, 1.4])
+    assert paid == sorted(paid) and paid[0] > 0.0 and paid[-1] <= 1.0
+    np.testing.assert_allclose(paid[-1], distance_score(best[0], D_REF, BETA).mean())
+    # nothing new seen: the same fraction is paid again (the level, not the gain)
+    again = updated_best(np.full((1, 3), np.nan), best, D_REF)
+    assert float(inspected_fraction(again, D_REF, BETA)[0]) == paid[-1]
+    every_face_at_d_ref = np.full((2, 60), D_REF)
+    np.testing.assert_array_equal(inspected_fraction(every_face_at_d_ref, D_REF, BETA), [1.0, 1.0])

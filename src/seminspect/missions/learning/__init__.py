@@ -13,10 +13,11 @@ import importlib
 from typing import Any
 
 from seminspect.missions.learning.baselines import Controller, OrbitController, RandomController
-from seminspect.missions.learning.env import InspectionEnv, InspectionVectorEnv
+from seminspect.missions.learning.env import InspectionVectorEnv
 from seminspect.missions.learning.env_config import EnvConfig
 from seminspect.missions.learning.evaluation import EpisodeTrace, EvaluationResult, evaluate
 from seminspect.missions.learning.rooms import Room, sample_room
+from seminspect.missions.learning.single_env import InspectionEnv
 from seminspect.missions.learning.train_config import TrainConfig
 
 #: Public name -> the module that defines it (imported lazily: torch is an optional extra).

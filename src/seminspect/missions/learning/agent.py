@@ -15,8 +15,9 @@ import numpy as np
 import torch
 from numpy.typing import NDArray
 
-from seminspect.missions.learning.checkpoints import load_policy
+from seminspect.missions.learning.checkpoints import read_checkpoint
 from seminspect.missions.learning.env import InspectionVectorEnv
+from seminspect.missions.learning.env_config import EnvConfig
 from seminspect.missions.learning.policy import InspectionPolicy, as_tensors
 
 #: The checkpoint inside the package: (package, relative path).
@@ -32,11 +33,15 @@ def shipped_policy_path() -> Path:
 class LearnedController:
     """Drive rooms with a trained :class:`InspectionPolicy` (mean action, no sampling).
 
-    The recurrent state is kept per room and cleared at :meth:`reset`.
+    The recurrent state is kept per room and cleared at :meth:`reset`. ``env_config`` is the
+    environment the policy was trained in (its checkpoint's): what it should be flown in.
     """
 
-    def __init__(self, policy: InspectionPolicy, deterministic: bool = True) -> None:
+    def __init__(
+        self, policy: InspectionPolicy, env_config: EnvConfig, *, deterministic: bool = True
+    ) -> None:
         self.policy = policy.eval()
+        self.env_config = env_config
         self.deterministic = deterministic
         self._hidden = policy.initial_state(0)
         self._generator = torch.Generator().manual_seed(0)
@@ -58,4 +63,5 @@ class LearnedController:
 
 def load_controller(path: Path | None = None) -> LearnedController:
     """The controller of a checkpoint file, or of the shipped policy when ``path`` is None."""
-    return LearnedController(load_policy(shipped_policy_path() if path is None else path))
+    checkpoint = read_checkpoint(shipped_policy_path() if path is None else path)
+    return LearnedController(checkpoint.policy, checkpoint.env_config)

@@ -67,8 +67,9 @@ class OrbitController:
     def act(self, env: InspectionVectorEnv, obs: dict[str, NDArray[np.float32]]) -> NDArray:
         cfg = env.config
         position, yaw = env.positions(), env.yaws()
-        centre = np.array([room.solids.centre[0] for room in env.rooms])
-        size = np.array([room.solids.size[0] for room in env.rooms])
+        rooms = env.rooms
+        bound = np.array([room.target_box for room in rooms])
+        centre = bound.mean(axis=1)
         offset = position[:, :2] - centre[:, :2]
         angle = np.arctan2(offset[:, 1], offset[:, 0])
         step = np.angle(
@@ -76,13 +77,13 @@ class OrbitController:
         )
         self._swept += np.abs(step)
         self._last_angle = angle
-        radius = size[:, 0] + cfg.d_ref
+        radius = np.array([room.target_radius for room in rooms]) + cfg.d_ref
         distance = np.linalg.norm(offset, axis=1)
         outward = offset / np.maximum(distance, 1e-6)[:, None]
         tangent = np.stack([-outward[:, 1], outward[:, 0]], axis=1)
-        top = centre[:, 2] + size[:, 1]
+        top = bound[:, 1, 2]
         height = np.where(self._swept < 2 * math.pi, centre[:, 2], top + self.above_top)
-        height = np.minimum(height, cfg.room_size[2] - 0.5)
+        height = np.minimum(height, np.array([room.size[2] for room in rooms]) - 0.5)
         command = np.zeros((env.num_envs, 3))
         command[:, :2] = self.gain * (radius - distance)[:, None] * outward + 0.6 * tangent
         command[:, 2] = self.gain * (height - position[:, 2])

@@ -1,10 +1,13 @@
-"""Policy checkpoints: the weights with the network and training settings that made them.
+"""Policy checkpoints: the weights with the network, training and environment settings that
+made them.
 
 One file, written atomically by :func:`save_checkpoint`; :func:`read_checkpoint` turns any way
 it can be missing, broken or made for another network into a one-line
 :class:`~seminspect.core.errors.FileFormatError`. Before unpickling it checks every member's
 CRC (``torch.load`` does not, so damaged weights would load as other numbers) and then the
-types of the fields the file declares.
+types of the fields the file declares. Version 1 (policy v1: the shipped policy and the
+ablations in ``bench/checkpoints/rl``) recorded no environment: it reads as
+:meth:`EnvConfig.legacy`, the environment those were trained in.
 """
 
 from __future__ import annotations
@@ -22,11 +25,14 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from seminspect.core.errors import FileFormatError
 from seminspect.core.io import atomic_write_with
 from seminspect.core.validation import describe_validation_error
+from seminspect.missions.learning.env_config import EnvConfig
 from seminspect.missions.learning.policy import InspectionPolicy, PolicyConfig
 from seminspect.missions.learning.train_config import TrainConfig
 
 CHECKPOINT_FORMAT = "seminspect-rl-policy"
-CHECKPOINT_VERSION = 1
+CHECKPOINT_VERSION = 2
+#: Version 1 recorded no env config (read as :meth:`EnvConfig.legacy`).
+SUPPORTED_VERSIONS = (1, 2)
 #: The file name a training run saves its checkpoint under.
 CHECKPOINT_NAME = "checkpoint.pt"
 
@@ -39,6 +45,7 @@ class Checkpoint:
     policy_config: PolicyConfig
     train_config: TrainConfig | None
     steps: int
+    env_config: EnvConfig  # the rooms it was trained in (and should be flown in)
 
 
 class _Declared(BaseModel):
@@ -48,11 +55,16 @@ class _Declared(BaseModel):
 
     policy_config: dict[str, Any]
     train_config: dict[str, Any] | None = None
+    env_config: dict[str, Any] | None = None  # None only in version 1
     steps: int = Field(0, ge=0, strict=True)  # strict: a bool or "many" is not a step count
 
 
 def save_checkpoint(
-    path: str | Path, policy: InspectionPolicy, train_config: TrainConfig | None, steps: int
+    path: str | Path,
+    policy: InspectionPolicy,
+    train_config: TrainConfig | None,
+    steps: int,
+    env_config: EnvConfig,
 ) -> Path:
     """Write the policy's weights and configurations atomically."""
     payload = {
@@ -60,6 +72,7 @@ def save_checkpoint(
         "version": CHECKPOINT_VERSION,
         "policy_config": policy.config.model_dump(mode="json"),
         "train_config": None if train_config is None else train_config.model_dump(mode="json"),
+        "env_config": env_config.model_dump(mode="json"),
         "steps": steps,
         "state_dict": policy.state_dict(),
     }
@@ -73,18 +86,21 @@ def read_checkpoint(path: str | Path) -> Checkpoint:
     if not source.is_file():
         reason = "is a directory" if source.is_dir() else "no such file"
         raise FileFormatError(f"{source}: {reason}, expected a policy checkpoint")
-    _check_archive(source)
+    check_archive(source, "policy checkpoint", "copy the file again or train a new one")
     try:
         payload = torch.load(source, map_location="cpu", weights_only=True)
     except (pickle.UnpicklingError, RuntimeError, EOFError, ValueError, zipfile.BadZipFile) as exc:
-        raise _unreadable(source, exc) from None
+        raise unreadable(source, "policy checkpoint", exc) from None
     if not isinstance(payload, dict) or payload.get("format") != CHECKPOINT_FORMAT:
         raise FileFormatError(f"{source}: not a {CHECKPOINT_FORMAT} checkpoint")
-    if payload.get("version") != CHECKPOINT_VERSION:
+    version = payload.get("version")
+    if version not in SUPPORTED_VERSIONS:
         raise FileFormatError(
-            f"{source}: checkpoint version {payload.get('version')!r} is not supported "
-            f"(supported: {CHECKPOINT_VERSION})"
+            f"{source}: checkpoint version {version!r} is not supported "
+            f"(supported: {', '.join(map(str, SUPPORTED_VERSIONS))})"
         )
+    if version >= 2 and payload.get("env_config") is None:
+        raise FileFormatError(f"{source}: a version {version} checkpoint needs its env_config")
     try:
         declared = _Declared.model_validate(payload)
     except ValidationError as exc:
@@ -93,6 +109,11 @@ def read_checkpoint(path: str | Path) -> Checkpoint:
         policy_config = PolicyConfig.model_validate(declared.policy_config)
         train = declared.train_config
         train_config = None if train is None else TrainConfig.model_validate(train)
+        env_config = (
+            EnvConfig.legacy(use_svs=policy_config.use_svs)
+            if declared.env_config is None
+            else EnvConfig.model_validate(declared.env_config)
+        )
     except ValidationError as exc:
         message = describe_validation_error(exc, "configuration")
         raise FileFormatError(f"{source}: {message}") from None
@@ -104,26 +125,24 @@ def read_checkpoint(path: str | Path) -> Checkpoint:
             f"{source}: its weights do not fit its policy configuration"
         ) from None
     policy.eval()
-    return Checkpoint(policy, policy_config, train_config, declared.steps)
+    return Checkpoint(policy, policy_config, train_config, declared.steps, env_config)
 
 
-def _check_archive(source: Path) -> None:
-    """Refuse a checkpoint archive with a member whose bytes no longer match their CRC."""
+def check_archive(source: Path, kind: str, remedy: str) -> None:
+    """Refuse a ``torch.save`` archive with a member whose bytes no longer match their CRC."""
     try:
         with zipfile.ZipFile(source) as archive:
             damaged = archive.testzip()
     except (zipfile.BadZipFile, zlib.error, EOFError, NotImplementedError) as exc:
-        raise _unreadable(source, exc) from None
+        raise unreadable(source, kind, exc) from None
     if damaged is not None:
-        raise FileFormatError(
-            f"{source}: damaged policy checkpoint ({damaged} fails its CRC check); "
-            "copy the file again or train a new one"
-        )
+        raise FileFormatError(f"{source}: damaged {kind} ({damaged} fails its CRC check); {remedy}")
 
 
-def _unreadable(source: Path, exc: Exception) -> FileFormatError:
+def unreadable(source: Path, kind: str, exc: Exception) -> FileFormatError:
+    """The one-line error of a file ``torch.load`` could not read."""
     first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-    return FileFormatError(f"{source}: not a readable policy checkpoint ({first})")
+    return FileFormatError(f"{source}: not a readable {kind} ({first})")
 
 
 def load_policy(path: str | Path) -> InspectionPolicy:

@@ -11,25 +11,23 @@ Per step (10 Hz, the paper's image rate):
   it, integrated in closed form over the step, with a random disturbance acceleration
   (004 Sec III-E). The vehicle stays level: orientation is yaw only.
 - The camera (87 x 58 deg, 96 x 54 pixels) and a 360 x 90 deg LiDAR are cast; their noisy ranges
-  (standard deviation growing linearly with range, Sec III-E) mark occupied cells of the robot's
-  own 0.1 m map (range data only, Sec III-A).
+  (sigma growing linearly with range, Sec III-E) update the robot's own 0.1 m map (range data
+  only, Sec III-A): three-state (``ego_map``) carves free space along the beams and mapping
+  pixels and marks every return occupied; binary (policy v1) only marks returns.
 - Observation eq (4): state s_t (eq (1)) with uniform noise, the previous action, the masked
-  depth D_t∘S_t, the ego-centric occupancy map m^o and the spatial visit score map m^h (eq (3)),
-  both 21^3 at 0.1 m in the yaw-aligned body frame.
-- Reward eq (6): face-mesh reward f_t (eqs (7)-(9)), semantic-search reward v_t (eq (10)) and the
-  collision penalty p_t (-1 when an occupied cell of m^o lies within d_coll). Contact (true
-  clearance below the robot radius) is a crash and ends the episode; reaching the episode
-  length without one is a timeout (Sec IV-A).
-
-The state vector (17 values): position relative to the room centre divided by the half size,
-quaternion (w, x, y, z), body-frame linear velocity (m/s), angular velocity (rad/s), then the
-previous action. The quaternion is scalar-first, unlike seminspect's ``[x, y, z, w]`` poses
-(:mod:`seminspect.geometry.transforms`): the shipped policy was trained on this order. The
-paper states velocities in the inertial frame; body-frame velocities keep the whole
-observation ego-centric like the maps, which the policy then need not rotate.
+  depth D_t∘S_t, the ego-centric occupancy map m^o (free 0, unknown 0.5, occupied 1; binary:
+  occupied and outside the map 1, else 0) and the spatial visit score map m^h (eq (3)), both
+  21^3 at 0.1 m in the yaw-aligned body frame.
+- Reward eq (6): face-mesh reward f_t (eqs (7)-(9), faces in the focus area only; the fraction
+  of faces inspected, weighted by distance, or v1's repaid scores), semantic-search reward v_t
+  (eq (10)) and the collision penalty p_t (-1 with an occupied m^o cell within d_coll; graded:
+  rising linearly to 0 at ``penalty_reach``). Contact (true clearance below the robot radius)
+  is a crash, ends the episode and costs ``crash_penalty``; reaching the episode length
+  without one is a timeout (Sec IV-A). Coverage: lenient and strict (a measure only).
 
 The parts have modules of their own: :mod:`.env_config` (the settings), :mod:`.sensors`,
-:mod:`.maps`, :mod:`.rewards` and :mod:`.dynamics`; this one steps them together.
+:mod:`.maps`, :mod:`.rewards`, :mod:`.face_views` and :mod:`.dynamics` (with the state
+vector's layout); this one steps them together.
 """
 
 from __future__ import annotations
@@ -41,22 +39,30 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 from gymnasium.vector import AutoresetMode
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.rng import make_rng
-from seminspect.geometry.transforms import body_from_world, world_from_body
-from seminspect.missions.learning.dynamics import first_order_step
+from seminspect.geometry.transforms import world_from_body
+from seminspect.missions.learning.dynamics import first_order_step, state_rows
 from seminspect.missions.learning.env_config import ACTION_SIZE, STATE_SIZE, EnvConfig
+from seminspect.missions.learning.face_views import (
+    FaceRecord,
+    face_views,
+    incidence_degrees,
+    triangle_normals,
+)
 from seminspect.missions.learning.maps import (
+    BINARY_VALUES,
+    THREE_STATE_VALUES,
+    ego_maps,
     ego_offsets,
-    gather_ego,
-    mark_hits,
     spatial_visit_scores,
+    update_maps,
 )
 from seminspect.missions.learning.rewards import (
     collision_penalty,
-    face_scores,
+    graded_penalty,
     semantic_search_reward,
 )
 from seminspect.missions.learning.rooms import (
@@ -85,7 +91,8 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
     """``num_envs`` rooms stepped together (SAME_STEP autoreset unless ``autoreset=False``).
 
     Without autoreset a finished room is frozen (zero reward, unchanged observation) until the
-    next :meth:`reset`, which suits evaluation: every room runs exactly one episode.
+    next :meth:`reset`, which suits evaluation: every room runs exactly one episode. ``threads``:
+    ray casting's and the map kernels' (blocks of rooms); the results never depend on it.
     """
 
     metadata = {"autoreset_mode": AutoresetMode.SAME_STEP}  # noqa: RUF012 - gymnasium API
@@ -136,22 +143,30 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         self._lidar = lidar_rays(cfg.lidar_beams)
         self._focus = focus_mask(cfg.image_size)
         self._mapped = mapping_pixels(cfg.image_size)
+        # The rays that carve free space: the mapping pixels and every beam, wherever the
+        # target is (its pixels too would double the walks for 0.003 % of the ego cells)
+        self._carving = np.concatenate([self._mapped, np.ones(len(self._lidar), dtype=bool)])
         self._offsets = ego_offsets(cfg.map_cells, cfg.map_resolution)
-        self._near = np.linalg.norm(self._offsets, axis=1) <= self.config.d_coll
-        self._spacing = self.config.room_size[0] + ROOM_GAP
+        radius = np.linalg.norm(self._offsets, axis=1)  # the m^o cells p_t reads, how far
+        reach = cfg.d_coll if cfg.proximity_penalty == "binary" else cfg.penalty_reach
+        self._near = np.flatnonzero(radius <= reach)
+        self._near_radius = radius[self._near]
+        self._cell_values = BINARY_VALUES if cfg.ego_map == "binary" else THREE_STATE_VALUES
+        self._spacing = self.config.largest_room[0] + ROOM_GAP  # rooms drawn smaller fit too
 
     def _allocate(self) -> None:
         count, cfg = self.num_envs, self.config
-        cells = np.ceil(np.asarray(cfg.room_size) / cfg.map_resolution).astype(int)
+        cells = np.ceil(np.asarray(cfg.largest_room) / cfg.map_resolution).astype(int)
         # z, y, x order: the ego cells are walked x-fastest, so lookups stay close in memory.
         self._occupancy = np.zeros((count, *cells[::-1]), dtype=np.uint8)
         self._visits = np.zeros((count, *cells[::-1]), dtype=np.uint16)
         self._position = np.zeros((count, 3))
+        self._room_size = np.tile(np.asarray(cfg.room_size, dtype=np.float64), (count, 1))
         self._velocity = np.zeros((count, 3))
         self._yaw = np.zeros(count)
         self._yaw_rate = np.zeros(count)
         self._previous_action = np.zeros((count, ACTION_SIZE), dtype=np.float32)
-        self._best = np.full((count, TARGET_FACES), np.inf)
+        self._faces = FaceRecord(count, cfg)
         self._steps = np.zeros(count, dtype=np.int64)
         self._return = np.zeros(count)
         self._done = np.zeros(count, dtype=bool)
@@ -183,7 +198,15 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
 
     def coverage(self) -> NDArray[np.float64]:
         """Fraction of each room's target faces inspected within ``inspect_range`` so far."""
-        return (self._best <= self.config.inspect_range).mean(axis=1)
+        return (self._faces.best <= self.config.inspect_range).mean(axis=1)
+
+    def strict_seen(self) -> NDArray[np.bool_]:
+        """``(num_envs, faces)``: faces the strict rule passed once (a measure: no reward)."""
+        return self._faces.strict.copy()
+
+    def distance_scores(self) -> NDArray[np.float64]:
+        """``(num_envs, faces)``: best distance score s(d) of any focus-area view (0: unseen)."""
+        return self._faces.distance_scores()
 
     def positions(self) -> NDArray[np.float64]:
         """True ``(num_envs, 3)`` robot positions in room coordinates (for baselines, pictures)."""
@@ -195,7 +218,7 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
 
     def face_distances(self, env: int) -> NDArray[np.float64]:
         """Best viewing distance d_f of each target face of one room (inf: never seen)."""
-        return self._best[env].copy()
+        return self._faces.best[env].copy()
 
     def track(self, env: int) -> NDArray[np.float64]:
         """Recorded ``(T, 5)`` rows (x, y, z, yaw, coverage) of one room's episode."""
@@ -206,12 +229,17 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, NDArray[np.float32]], dict[str, Any]]:
+        """``options``: ``obstacles`` (counts, see :meth:`set_obstacles`) and ``rooms`` (one
+        :class:`Room` per env for this episode instead of drawn ones; autoreset draws again)."""
         if seed is not None:
             self._seed = seed
             self._rngs = [make_rng(seed, "learning", f"env-{i}") for i in range(self.num_envs)]
         if options and "obstacles" in options:
             self.set_obstacles(options["obstacles"])
-        self._rooms = [self._sample_room(i) for i in range(self.num_envs)]
+        if options and "rooms" in options:
+            self._rooms = _given_rooms(options["rooms"], self.num_envs, self.config.largest_room)
+        else:
+            self._rooms = [self._sample_room(i) for i in range(self.num_envs)]
         every = np.arange(self.num_envs)
         self._begin(every)
         self._rebuild_scene()
@@ -258,15 +286,39 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
             obs = self._restart(np.flatnonzero(ended))
         return obs, reward.astype(np.float32), crash, timeout, info
 
+    def observe_at(self, positions: ArrayLike, yaws: ArrayLike) -> dict[str, NDArray[np.float32]]:
+        """Put each robot at a pose, at rest (velocity, yaw rate and a_{t-1} zero), and sense
+        as a step does: maps, face distances, strict flags. Replays another planner's
+        ``(num_envs, 3)`` positions and yaws through this camera; no step is counted."""
+        if self._caster is None:
+            raise InvalidInputError("call reset() before observe_at()")
+        position = np.asarray(positions, dtype=np.float64)
+        yaw = np.asarray(yaws, dtype=np.float64)
+        if position.shape != (self.num_envs, 3) or yaw.shape != (self.num_envs,):
+            raise InvalidInputError(
+                f"observe_at needs ({self.num_envs}, 3) positions and ({self.num_envs},) yaws, "
+                f"got {position.shape} and {yaw.shape}"
+            )
+        if not (np.all(np.isfinite(position)) and np.all(np.isfinite(yaw))):
+            raise InvalidInputError("poses must be finite")
+        self._position[:] = position
+        self._yaw[:] = (yaw + math.pi) % (2.0 * math.pi) - math.pi  # as _move wraps
+        self._velocity[:] = 0.0
+        self._yaw_rate[:] = 0.0
+        self._previous_action[:] = 0.0
+        self._sense(np.arange(self.num_envs))
+        return self._copy_obs()
+
     # -- episode bookkeeping -------------------------------------------------------------------
 
     def _sample_room(self, env: int) -> Room:
-        return sample_room(self._rngs[env], int(self._obstacles[env]), self.config.room_size)
+        return sample_room(self._rngs[env], int(self._obstacles[env]), self.config)
 
     def _begin(self, envs: NDArray[np.int64]) -> None:
         for env in envs:
             room = self._rooms[env]
             self._position[env] = room.start
+            self._room_size[env] = room.size
             self._yaw[env] = room.start_yaw
             self._tracks[env] = []
         self._velocity[envs] = 0.0
@@ -274,7 +326,7 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         self._previous_action[envs] = 0.0
         self._occupancy[envs] = 0
         self._visits[envs] = 0
-        self._best[envs] = np.inf
+        self._faces.clear(envs)
         self._steps[envs] = 0
         self._return[envs] = 0.0
         self._done[envs] = False
@@ -291,6 +343,9 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
     def _rebuild_scene(self) -> None:
         vertices, triangles, self._face_of_triangle = side_by_side(self._rooms, self._spacing)
         self._caster = RayCaster(vertices, triangles)
+        target = self._face_of_triangle >= 0  # normals for the strict rule's incidence
+        self._normals = np.zeros((len(triangles), 3))
+        self._normals[target] = triangle_normals(vertices, triangles[target])
 
     def _copy_obs(self) -> dict[str, NDArray[np.float32]]:
         return {key: value.copy() for key, value in self._obs.items()}
@@ -317,7 +372,7 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
     def _crashed(self, envs: NDArray[np.int64]) -> NDArray[np.bool_]:
         solids = self._solids
         assert solids is not None
-        gap = clearance(self._position[envs], solids.rows(envs), np.asarray(self.config.room_size))
+        gap = clearance(self._position[envs], solids.rows(envs), self._room_size[envs])
         return gap < self.config.robot_radius
 
     # -- sensing ---------------------------------------------------------------------------------
@@ -326,29 +381,32 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         """Cast, map, fill the observation rows of ``envs``; return their f_t + v_t + p_t."""
         assert self._caster is not None and self._solids is not None
         cfg = self.config
-        target = self._solids.centre[envs, 0], self._solids.size[envs, 0]
         shift = np.outer(envs * self._spacing, (1.0, 0.0, 0.0))  # rooms' places in the scene
+        target_box = np.stack([self._rooms[e].target_box for e in envs]) + shift[:, None]
         origin = self._position[envs] + shift
         row, ray, starts, dirs = sensor_rays(
-            origin,
-            self._yaw[envs],
-            self._camera,
-            self._lidar,
-            self._mapped,
-            target[0] + shift,
-            target[1],
-            cfg.camera_range,
-        )
+            origin, self._yaw[envs], self._camera, self._lidar, self._mapped, target_box,
+            cfg.camera_range, self.threads,
+        )  # fmt: skip
         distance, tri = self._caster.cast(starts, dirs, cfg.camera_range, self.threads)
         distance = distance.astype(np.float64)
         noisy = self._noisy(envs, row, distance)
-        mark_hits(self._occupancy, envs[row], starts, dirs, noisy, shift, row, cfg.map_resolution)
+        carve = self._carving[ray] if cfg.ego_map == "three-state" else None
+        update_maps(
+            self._occupancy, envs[row], starts, dirs, noisy, shift, row, cfg.map_resolution,
+            carve, cfg.camera_range, self.threads,
+        )  # fmt: skip
         face = np.where(tri >= 0, self._face_of_triangle[np.maximum(tri, 0)], -1)
         on_target = np.flatnonzero((face >= 0) & (ray < len(self._camera)))
         self._fill_depth(envs, row[on_target], ray[on_target], noisy[on_target])
-        f_t = self._face_reward(
-            envs, row[on_target], ray[on_target], face[on_target], distance[on_target]
+        seen = on_target[self._focus[ray[on_target]]]  # only the focus area counts (Sec III-C)
+        views = face_views(
+            row[seen] * TARGET_FACES + face[seen],
+            distance[seen],
+            incidence_degrees(self._normals[tri[seen]], dirs[seen]),
+            len(envs) * TARGET_FACES,
         )
+        f_t = self._faces.update(envs, views)
         self._visit(envs)
         v_t, p_t = self._fill_maps(envs)
         self._fill_state(envs)
@@ -361,10 +419,10 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
     def _noisy(self, envs: NDArray[np.int64], row: NDArray, distance: NDArray) -> NDArray:
         """:func:`noisy_ranges`, each room drawing its noise from its own stream (the rays come
         grouped by room)."""
-        counts = np.bincount(row, minlength=len(envs))
-        noise = np.concatenate(
-            [self._rngs[e].standard_normal(n) for e, n in zip(envs, counts, strict=True)]
-        )
+        bounds = np.searchsorted(row, np.arange(len(envs) + 1))
+        noise = np.empty(len(row))  # filled in place: the values of one draw per room, no concat
+        for e, start, end in zip(envs, bounds[:-1], bounds[1:], strict=True):
+            self._rngs[e].standard_normal(out=noise[start:end])
         return noisy_ranges(distance, noise, self.config.depth_noise, self.config.camera_range)
 
     def _fill_depth(self, envs: NDArray, row: NDArray, pixel: NDArray, noisy: NDArray) -> None:
@@ -373,23 +431,6 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         depth = np.zeros((len(envs), width * height), dtype=np.float32)
         depth[row, pixel] = noisy * self._camera_cos[pixel] / self.config.camera_range
         self._obs["depth"][envs] = depth.reshape(len(envs), 1, height, width)
-
-    def _face_reward(
-        self, envs: NDArray, row: NDArray, pixel: NDArray, face: NDArray, distance: NDArray
-    ) -> NDArray[np.float64]:
-        """f_t (eq (9)): scores of faces seen closer to d_ref in the focus area this step."""
-        cfg = self.config
-        focus = self._focus[pixel]
-        key = row[focus] * TARGET_FACES + face[focus]
-        size = len(envs) * TARGET_FACES
-        total = np.bincount(key, weights=distance[focus], minlength=size)
-        count = np.bincount(key, minlength=size)
-        mean = np.divide(total, count, out=np.full(size, np.nan), where=count > 0)
-        scores, best = face_scores(
-            mean.reshape(len(envs), -1), self._best[envs], cfg.d_ref, cfg.alpha, cfg.beta
-        )
-        self._best[envs] = best
-        return scores.sum(axis=1)
 
     def _visit(self, envs: NDArray[np.int64]) -> None:
         cell = np.floor(self._position[envs] / self.config.map_resolution).astype(np.int64)
@@ -400,75 +441,51 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         """m^o and m^h (eq (3)); returns v_t (eq (10)) and p_t for the rows."""
         cfg = self.config
         n = cfg.map_cells
-        occupancy = np.empty((len(envs), n**3), dtype=np.float32)
-        counts = np.empty((len(envs), n**3), dtype=np.float32)
-        gather_ego(
-            self._occupancy,
-            self._visits,
-            envs,
-            self._position[envs],
-            self._yaw[envs],
-            self._offsets,
-            cfg.map_resolution,
-            occupancy,
-            counts,
-        )
+        occupancy, counts = ego_maps(
+            self._occupancy, self._visits, envs, self._position[envs], self._yaw[envs],
+            self._offsets, cfg.map_resolution, self._cell_values, self.threads,
+        )  # fmt: skip
         scores, totals = spatial_visit_scores(counts)
         maps = self._obs["maps"]
         maps[envs, 0] = occupancy.reshape(len(envs), n, n, n)
         maps[envs, 1] = scores.reshape(len(envs), n, n, n) if cfg.use_svs else 0.0
-        penalty = collision_penalty(occupancy[:, self._near])
+        near = occupancy[:, self._near]
+        if cfg.proximity_penalty == "binary":
+            penalty = collision_penalty(near)
+        else:
+            penalty = graded_penalty(near, self._near_radius, cfg.d_coll, cfg.penalty_reach)
         return semantic_search_reward(totals, cfg.gamma, cfg.delta), penalty
 
     def _fill_state(self, envs: NDArray[np.int64]) -> None:
-        """Noisy s_t (eq (1)) in the documented layout, then a_{t-1}."""
-        cfg = self.config
-        half = np.asarray(cfg.room_size) / 2.0
-        noise = np.stack([self._rngs[e].uniform(-1.0, 1.0, 8) for e in envs]) * cfg.state_noise
-        yaw = self._yaw[envs] + noise[:, 3]
-        body_v = body_from_world(self._velocity[envs], self._yaw[envs])
+        """Noisy s_t (eq (1), :func:`.dynamics.state_rows`), then a_{t-1}."""
+        noise = np.stack([self._rngs[e].uniform(-1.0, 1.0, 8) for e in envs])
         state = self._obs["state"]
-        state[envs, 0:3] = (self._position[envs] + noise[:, :3] - half) / half
-        # (w, x, y, z), scalar first: the policy's order. Not quat_from_yaw ([x, y, z, w], one
-        # yaw at a time with math.cos): numpy over the batch is what the policy was trained on.
-        state[envs, 3] = np.cos(yaw / 2)
-        state[envs, 4:6] = 0.0
-        state[envs, 6] = np.sin(yaw / 2)
-        state[envs, 7:10] = body_v + noise[:, 4:7]
-        state[envs, 10:12] = 0.0
-        state[envs, 12] = self._yaw_rate[envs] + noise[:, 7]
+        state[envs, :13] = state_rows(
+            self._position[envs], self._room_size[envs], self._yaw[envs], self._velocity[envs],
+            self._yaw_rate[envs], noise * self.config.state_noise, self.config.yaw_encoding,
+        )  # fmt: skip
         state[envs, 13:17] = self._previous_action[envs]
 
+    # -- pickling (a training run's saved state) ------------------------------------------------
 
-class InspectionEnv(gym.Env):
-    """One room as a plain ``gymnasium.Env`` (no autoreset), for tools that want a single env."""
+    def __getstate__(self) -> dict[str, Any]:
+        """Every attribute but the ray caster, rebuilt from the rooms on load: its Embree scene
+        would pickle as a bare handle into this process's memory."""
+        return self.__dict__ | {"_caster": None}
 
-    metadata = {"render_modes": []}  # noqa: RUF012 - gymnasium API
-
-    def __init__(self, config: EnvConfig | None = None, seed: int = 0) -> None:
-        self._vector = InspectionVectorEnv(1, config, seed=seed, autoreset=False)
-        self.observation_space = self._vector.single_observation_space
-        self.action_space = self._vector.single_action_space
-
-    def reset(
-        self, *, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[dict[str, NDArray[np.float32]], dict[str, Any]]:
-        super().reset(seed=seed)
-        obs, info = self._vector.reset(seed=seed, options=options)
-        return _row(obs), {"coverage": float(info["coverage"][0])}
-
-    def step(
-        self, action: NDArray
-    ) -> tuple[dict[str, NDArray[np.float32]], float, bool, bool, dict[str, Any]]:
-        obs, reward, crash, timeout, info = self._vector.step(np.asarray(action)[None])
-        return (
-            _row(obs),
-            float(reward[0]),
-            bool(crash[0]),
-            bool(timeout[0]),
-            {"coverage": float(info["coverage"][0])},
-        )
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        if self._rooms:
+            self._rebuild_scene()
 
 
-def _row(obs: dict[str, NDArray[np.float32]]) -> dict[str, NDArray[np.float32]]:
-    return {key: value[0] for key, value in obs.items()}
+def _given_rooms(rooms: Sequence[Room], count: int, largest: Sequence[float]) -> list[Room]:
+    """The rooms of ``reset(options={"rooms": ...})``, one per env, each within the scene's
+    and the maps' size."""
+    given = list(rooms)
+    if len(given) != count or not all(isinstance(room, Room) for room in given):
+        raise InvalidInputError(f"options['rooms'] needs {count} Room objects, got {len(given)}")
+    for room in given:
+        if np.any(room.size > np.asarray(largest) + 1e-9):
+            raise InvalidInputError(f"room {tuple(room.size)} exceeds the largest {largest}")
+    return given

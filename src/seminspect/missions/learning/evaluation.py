@@ -3,12 +3,20 @@
 For each obstacle count K, exactly ``episodes`` rooms are run to the end of their episode
 (batches of at most ``num_envs`` rooms stepped together without autoreset, so each room runs
 one episode and then freezes). A crash is contact with anything; a timeout is an episode that
-stayed collision-free to its end (Sec IV-A), so crash % + timeout % = 100 %. The coverage of an
-episode is the fraction of the target's N_f faces seen within ``inspect_range`` when it ends.
+stayed collision-free to its end (Sec IV-A), so crash % + timeout % = 100 %; both come with
+Wilson 95 % intervals.
 
-Each batch is reset with a seed derived from ``seed``, K and the batch index, so two controllers
-evaluated with the same ``seed`` and ``num_envs`` meet the same rooms; the rooms' fingerprints
-are kept to show it.
+Coverage is measured two ways. Lenient (policy v1's figure): the share of the target's N_f
+faces seen within ``inspect_range``. Strict (004 Fig 5: "all feasible faces ... seen within the
+required inspection distance"): the share of the room's feasible faces
+(:func:`~seminspect.missions.learning.feasibility.feasible_faces`, decided once per room at its
+reset) seen once by the strict rule of the environment; a face seen strictly counts as
+feasible. The coverage curves are strict, with the mean distance score over the same faces.
+
+The rooms are the protocol's (:func:`evaluation_config`): what a policy sees and is paid comes
+from its own environment settings. Each batch is reset with a seed derived from ``seed``, K and
+the batch index, so two controllers evaluated with the same ``seed`` and ``num_envs`` meet the
+same rooms; the rooms' fingerprints are kept to show it.
 """
 
 from __future__ import annotations
@@ -23,6 +31,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, ValidationError
+from scipy import stats
 
 from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.core.io import read_versioned_json, write_versioned_json
@@ -30,11 +39,23 @@ from seminspect.core.rng import make_rng
 from seminspect.core.validation import build, describe_validation_error
 from seminspect.missions.learning.baselines import Controller
 from seminspect.missions.learning.env import InspectionVectorEnv
-from seminspect.missions.learning.env_config import EnvConfig
+from seminspect.missions.learning.env_config import EnvConfig, TargetShape
+from seminspect.missions.learning.feasibility import feasible_faces
 from seminspect.missions.learning.rooms import Room
 
 FORMAT = "seminspect.rl-evaluation"
-VERSION = 1
+#: 2: strict coverage, intervals, the checkpoint's SHA-256 (version 1 is refused).
+VERSION = 2
+#: What remakes the stored evaluations (named when an old file is refused).
+REGENERATE = ".venv/bin/python bench/rl_reproduction.py"
+#: The rooms of every evaluation: 004 Sec IV-A's 10 x 10 x 4 m, Sec III-E's 90 s episodes,
+#: obstacles anywhere that leaves the robot room to pass.
+PROTOCOL_ROOMS: dict[str, object] = {
+    "room_size": (10.0, 10.0, 4.0),
+    "room_size_range": None,
+    "episode_seconds": 90.0,
+    "obstacle_rule": "surface",
+}
 #: 004 Table I (the trained policy): obstacles -> (coverage %, crash %, timeout %).
 PAPER_TABLE1: dict[int, tuple[float, float, float]] = {
     0: (92.1, 0.0, 100.0),
@@ -62,22 +83,36 @@ Progress = Callable[[str, float], None]
 
 
 class ObstacleResult(BaseModel):
-    """Outcome of every episode at one obstacle count (percentages in 0-100)."""
+    """Outcome of every episode at one obstacle count (percentages in 0-100).
+
+    Intervals are 95 %: Wilson's for the crash and timeout rates, Student's t for the mean
+    strict coverage.
+    """
 
     model_config = ConfigDict(frozen=True, extra="forbid")
 
     obstacles: int
     episodes: int
     coverage_pct: float
+    strict_coverage_pct: float
+    strict_coverage_ci: tuple[float, float]
+    #: Mean over episodes of the mean distance score (0-1) of their feasible faces.
+    distance_score: float
     crash_pct: float
+    crash_ci: tuple[float, float]
     timeout_pct: float
-    #: Per episode: final coverage %, crashed or not, steps flown, room fingerprint.
+    timeout_ci: tuple[float, float]
+    #: Per episode: final lenient and strict coverage %, distance score, feasible faces (or
+    #: seen strictly), crashed or not, steps flown, room fingerprint.
     coverage: list[float]
+    strict_coverage: list[float]
+    distance_scores: list[float]
+    feasible_faces: list[int]
     crashed: list[bool]
     length: list[int]
     rooms: list[str]
-    #: Coverage % against ``curve_times``: mean, 5th and 95th percentile over the episodes,
-    #: and the curves of the first ``KEPT_CURVES`` episodes.
+    #: Strict coverage % against ``curve_times``: mean, 5th and 95th percentile over the
+    #: episodes, and the curves of the first ``KEPT_CURVES`` episodes.
     curve_times: list[float]
     curve_mean: list[float]
     curve_p5: list[float]
@@ -93,8 +128,11 @@ class EvaluationResult(BaseModel):
     policy: str
     seed: int
     num_envs: int
-    #: The environment's settings; each row replaces ``obstacles`` with its own count.
+    #: The environment's settings (:func:`evaluation_config`); each row replaces
+    #: ``obstacles`` with its own count.
     config: EnvConfig
+    #: SHA-256 of the checkpoint file flown; None for a baseline.
+    checkpoint_sha256: str | None
     wall_seconds: float
     results: list[ObstacleResult]
 
@@ -111,7 +149,11 @@ class EvaluationResult(BaseModel):
 
     @classmethod
     def from_json(cls, path: str | os.PathLike[str]) -> EvaluationResult:
-        document = read_versioned_json(path, FORMAT, [VERSION])
+        document = read_versioned_json(path, FORMAT, [1, VERSION])
+        if document["version"] == 1:
+            raise FileFormatError(
+                f"{path}: a version-1 evaluation (no strict coverage); regenerate it: {REGENERATE}"
+            )
         payload = {k: v for k, v in document.items() if k not in {"format", "version"}}
         try:
             return cls.model_validate(payload)
@@ -138,11 +180,31 @@ class _Tally:
     """Per-episode outcomes of one obstacle count, filled batch by batch."""
 
     coverage: list[float] = field(default_factory=list)
+    strict: list[float] = field(default_factory=list)
+    scores: list[float] = field(default_factory=list)
+    feasible: list[int] = field(default_factory=list)
     crashed: list[bool] = field(default_factory=list)
     timed_out: list[bool] = field(default_factory=list)
     length: list[int] = field(default_factory=list)
     rooms: list[str] = field(default_factory=list)
     curves: list[NDArray[np.float64]] = field(default_factory=list)
+
+
+def evaluation_config(
+    policy_env: EnvConfig, shapes: Sequence[TargetShape] = ("cylinder",)
+) -> EnvConfig:
+    """The protocol's rooms (:data:`PROTOCOL_ROOMS`, objects of ``shapes``) with everything a
+    policy sees and is paid as in ``policy_env``, the environment it was trained in."""
+    values = {**policy_env.model_dump(), **PROTOCOL_ROOMS, "target_shapes": tuple(shapes)}
+    return build(EnvConfig, values, "evaluation environment")
+
+
+def controller_evaluation_config(
+    controller: Controller, shapes: Sequence[TargetShape] = ("cylinder",)
+) -> EnvConfig:
+    """:func:`evaluation_config` of the environment ``controller`` was trained in: its
+    ``env_config`` (a checkpoint's); a baseline, trained in none, gets the defaults."""
+    return evaluation_config(getattr(controller, "env_config", None) or EnvConfig(), shapes)
 
 
 def room_fingerprint(room: Room) -> str:
@@ -171,6 +233,7 @@ def evaluate(
     policy: str = "",
     threads: int = 1,
     traces: dict[int, EpisodeTrace] | None = None,
+    checkpoint_sha256: str | None = None,
 ) -> EvaluationResult:
     """Run ``episodes`` rooms per obstacle count with ``controller`` (004 Sec IV-A).
 
@@ -179,15 +242,17 @@ def evaluate(
         obstacle_counts: the K of each row (Table I: 0, 4, 9, 14, 19).
         episodes: rooms per obstacle count.
         seed: the rooms (and the environments' noise) follow from it.
-        config: environment settings; its ``obstacles`` is replaced by each K.
+        config: environment settings (default: :func:`evaluation_config` of the defaults);
+            its ``obstacles`` is replaced by each K.
         num_envs: rooms stepped together.
         progress: called with a label and the share of all steps done.
         policy: the controller's name, kept in the result.
         threads: ray-casting threads of the environment.
         traces: if given, receives the first episode of each K for pictures.
+        checkpoint_sha256: of the checkpoint ``controller`` flies, kept in the result.
     """
     counts = _checked_protocol(obstacle_counts, episodes, num_envs)
-    base = config or EnvConfig()
+    base = config or evaluation_config(EnvConfig())
     total = len(counts) * episodes * base.steps_per_episode
     started = time.perf_counter()
     results = []
@@ -218,6 +283,7 @@ def evaluate(
         seed=seed,
         num_envs=num_envs,
         config=base,
+        checkpoint_sha256=checkpoint_sha256,
         wall_seconds=time.perf_counter() - started,
         results=results,
     )
@@ -278,17 +344,21 @@ def _run_batch(
     tally: _Tally,
     advance: Callable[[int], None],
 ) -> None:
-    """One episode in every room of ``env``; outcomes appended to ``tally``."""
+    """One episode in every room of ``env``; outcomes appended to ``tally``.
+
+    The rooms' feasible faces are drawn from ``reset_seed`` too.
+    """
     cfg = env.config
     steps = cfg.steps_per_episode
     every = max(1, round(CURVE_INTERVAL * cfg.control_hz))
     obs, _ = env.reset(seed=reset_seed)
     controller.reset(env)
     fingerprints = [room_fingerprint(room) for room in env.rooms]
+    feasible = np.array([feasible_faces(room, cfg, reset_seed) for room in env.rooms])
     crashed = np.zeros(env.num_envs, dtype=bool)
     timed_out = np.zeros(env.num_envs, dtype=bool)
     length = np.full(env.num_envs, steps)
-    curve = [env.coverage()]
+    seen = [env.strict_seen()]
     for step in range(1, steps + 1):
         if not (crashed | timed_out).all():  # finished rooms are frozen: nothing left to step
             obs, _, crash, timeout, _ = env.step(controller.act(env, obs))
@@ -296,14 +366,52 @@ def _run_batch(
             crashed |= crash
             timed_out |= timeout
         if step % every == 0:
-            curve.append(env.coverage())
+            seen.append(env.strict_seen())
             advance(step)
+    # Scored over the faces feasible or seen strictly: a face seen strictly was feasible.
+    scored = feasible | seen[-1]
+    counts = scored.sum(axis=1)
+    curves = np.array(seen).sum(axis=2).T  # strictly seen faces only accumulate
     tally.coverage += (100.0 * env.coverage()).tolist()
+    tally.strict += _share(100.0 * curves[:, -1], counts, 100.0).tolist()
+    tally.scores += _share((env.distance_scores() * scored).sum(axis=1), counts, 1.0).tolist()
+    tally.feasible += counts.tolist()
     tally.crashed += crashed.tolist()
     tally.timed_out += timed_out.tolist()
     tally.length += length.tolist()
     tally.rooms += fingerprints
-    tally.curves += list(100.0 * np.array(curve).T)
+    tally.curves += list(_share(100.0 * curves, counts[:, None], 100.0))
+
+
+def _share(total: NDArray, counts: NDArray, empty: float) -> NDArray[np.float64]:
+    """``total / counts``; a room with no feasible face missed nothing: ``empty`` (full marks)."""
+    out = np.full(np.broadcast_shapes(total.shape, counts.shape), empty)
+    return np.divide(total, counts, out=out, where=counts > 0)
+
+
+def wilson_pct(flags: Sequence[bool]) -> tuple[float, float]:
+    """Wilson 95 % interval (in %) of the rate of ``True`` among ``flags``."""
+    interval = stats.binomtest(int(np.sum(flags)), len(flags)).proportion_ci(method="wilson")
+    return 100.0 * float(interval.low), 100.0 * float(interval.high)
+
+
+def interval_text(value: float, interval: tuple[float, float]) -> str:
+    """``"56.2 [48.0-64.4]"``: a percentage and its interval, one decimal (as 004's tables)."""
+    return f"{value:.1f} [{interval[0]:.1f}-{interval[1]:.1f}]"
+
+
+def mean_interval_pct(values: Sequence[float]) -> tuple[float, float]:
+    """Student-t 95 % interval of the mean of percentages, kept within 0-100.
+
+    One value tells nothing of the spread: (0, 100); equal values give a point.
+    """
+    if len(values) < 2:
+        return 0.0, 100.0
+    mean, sem = float(np.mean(values)), float(stats.sem(values))
+    if sem == 0.0:
+        return mean, mean
+    low, high = stats.t.interval(0.95, len(values) - 1, loc=mean, scale=sem)
+    return max(0.0, float(low)), min(100.0, float(high))
 
 
 def _summarise(obstacles: int, tally: _Tally, config: EnvConfig) -> ObstacleResult:
@@ -313,9 +421,17 @@ def _summarise(obstacles: int, tally: _Tally, config: EnvConfig) -> ObstacleResu
         obstacles=obstacles,
         episodes=len(tally.coverage),
         coverage_pct=float(np.mean(tally.coverage)),
+        strict_coverage_pct=float(np.mean(tally.strict)),
+        strict_coverage_ci=mean_interval_pct(tally.strict),
+        distance_score=float(np.mean(tally.scores)),
         crash_pct=100.0 * float(np.mean(tally.crashed)),
+        crash_ci=wilson_pct(tally.crashed),
         timeout_pct=100.0 * float(np.mean(tally.timed_out)),
+        timeout_ci=wilson_pct(tally.timed_out),
         coverage=tally.coverage,
+        strict_coverage=tally.strict,
+        distance_scores=tally.scores,
+        feasible_faces=tally.feasible,
         crashed=tally.crashed,
         length=tally.length,
         rooms=tally.rooms,

@@ -25,14 +25,19 @@ the value of its last observation rather than treated as terminal; rewards may b
 running standard deviation of the discounted return; obstacles enter by a curriculum (004 trains
 with nine obstacles and sets up a curriculum without giving its schedule: ours steps through
 obstacle counts at fractions of the training, 0, 4 then 9 by default).
+
+A run trains in pieces: :func:`train` starts one and :func:`resume` continues it from its
+``training-state.pt`` (:mod:`.training_state`), saved only at update boundaries (a stop signal
+waits for the update under way to end) and continued bit for bit.
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import Protocol
 
@@ -40,9 +45,10 @@ import numpy as np
 import torch
 from torch import Tensor
 
-from seminspect.core.interrupts import deferred_signals
+from seminspect.core.interrupts import deferred_signals, stop_on_signals
 from seminspect.core.rng import make_rng
 from seminspect.missions.learning.checkpoints import CHECKPOINT_NAME, save_checkpoint
+from seminspect.missions.learning.env_config import EnvConfig
 from seminspect.missions.learning.policy import (
     InspectionPolicy,
     PolicyConfig,
@@ -58,6 +64,11 @@ from seminspect.missions.learning.rollout import (
     final_observations,
 )
 from seminspect.missions.learning.train_config import TrainConfig
+from seminspect.missions.learning.training_state import (
+    TRAINING_STATE_NAME,
+    TrainingState,
+    save_training_state,
+)
 
 
 class VectorEnv(Protocol):
@@ -81,11 +92,12 @@ class TrainResult:
     """What :func:`train` leaves behind."""
 
     steps: int
-    updates: int
-    wall_s: float
+    updates: int  # done, all pieces of the run together
+    wall_s: float  # of this piece
     checkpoint: Path
     last: ProgressRow | None
     tensorboard: bool  # whether event files were written
+    finished: bool  # False: stopped by its time limit; resume() continues it
 
 
 def _torch_seed(seed: int, stream: str) -> int:
@@ -95,8 +107,10 @@ def _torch_seed(seed: int, stream: str) -> int:
 class _Run:
     """One training run: the policy, its optimiser and the environment's current state."""
 
-    def __init__(self, env: VectorEnv, policy: InspectionPolicy, config: TrainConfig):
-        self.env, self.policy, self.config = env, policy, config
+    def __init__(
+        self, env: VectorEnv, policy: InspectionPolicy, config: TrainConfig, env_config: EnvConfig
+    ):
+        self.env, self.policy, self.config, self.env_config = env, policy, config, env_config
         self.device = device = policy.log_std.device
         self.optimizer = torch.optim.Adam(policy.parameters(), lr=config.lr, eps=1e-5)
         self.sampler = torch.Generator(device).manual_seed(_torch_seed(config.seed, "actions"))
@@ -105,12 +119,71 @@ class _Run:
         self.rollout = Rollout.empty(
             config.rollout_steps, config.num_envs, policy.config.gru_size, device
         )
-        self.steps = 0
+        self.updates = self.steps = self.saved_at = 0
+        self.wall_s = 0.0  # training time up to the last update's end, all pieces together
         self.obstacles: int | None = None
-        self._apply_curriculum()
-        self.obs, _ = env.reset(seed=config.seed)
         self.hidden = policy.initial_state(config.num_envs)
         self.starts = torch.ones(config.num_envs, device=device)
+        self.obs: dict[str, np.ndarray] = {}
+        self.whole = False  # True at an update boundary: only then may the state be saved
+
+    def begin(self) -> None:
+        """Reset the env into the first rooms of a new run."""
+        self._apply_curriculum()
+        self.obs, _ = self.env.reset(seed=self.config.seed)
+        self.whole = True
+
+    def state(self, rows: tuple[ProgressRow, ...]) -> TrainingState:
+        """Everything that moves a number of the updates to come (at an update boundary)."""
+        run = {
+            "policy": self.policy.state_dict(),
+            "optimizer": self.optimizer.state_dict(),
+            "sampler": self.sampler.get_state(),
+            "torch_rng": torch.get_rng_state(),
+            "shuffle": self.shuffle.bit_generator.state,
+            "scaler": dict(vars(self.scaler)),
+            "saved_at": self.saved_at,
+            "wall_s": self.wall_s,
+            "obstacles": self.obstacles,
+            "hidden": self.hidden,
+            "starts": self.starts,
+            "obs": self.obs,
+            "env": self.env,
+        }
+        return TrainingState(
+            self.policy.config,
+            self.config,
+            self.env_config,
+            str(self.device),
+            self.updates,
+            self.steps,
+            rows,
+            run,
+        )
+
+    @classmethod
+    def restored(cls, state: TrainingState) -> _Run:
+        """The run :meth:`state` saved, on the device it trained on."""
+        saved = state.run
+        policy = InspectionPolicy(state.policy_config).to(state.device)
+        policy.load_state_dict(saved["policy"])
+        run = cls(saved["env"], policy, state.train_config, state.env_config)
+        run.optimizer.load_state_dict(saved["optimizer"])
+        run.sampler.set_state(saved["sampler"])
+        torch.set_rng_state(saved["torch_rng"])
+        run.shuffle.bit_generator.state = saved["shuffle"]
+        vars(run.scaler).update(saved["scaler"])
+        run.updates, run.steps = state.updates, state.steps
+        run.saved_at, run.wall_s, run.obstacles = (
+            saved["saved_at"],
+            saved["wall_s"],
+            saved["obstacles"],
+        )
+        run.hidden = saved["hidden"].to(run.device)
+        run.starts = saved["starts"].to(run.device)
+        run.obs = saved["obs"]
+        run.whole = True
+        return run
 
     def _apply_curriculum(self) -> None:
         count = self.config.obstacles_at(self.steps / self.config.total_steps)
@@ -213,7 +286,7 @@ class _Run:
         }
 
 
-# --- the entry point ------------------------------------------------------------------------
+# --- the entry points -----------------------------------------------------------------------
 
 
 def train(
@@ -222,66 +295,133 @@ def train(
     train_config: TrainConfig,
     out_dir: str | Path,
     *,
+    env_config: EnvConfig,
     progress: Callable[[ProgressRow], None] | None = None,
     device: torch.device | str = "cpu",
+    stop_after_s: float | None = None,
 ) -> TrainResult:
-    """Train a policy; ``make_env(num_envs, seed)`` builds the vector environment.
+    """Train a policy; ``make_env(num_envs, seed)`` builds the vector environment, whose
+    settings ``env_config`` names (each checkpoint records them).
 
     ``device`` holds the network and the rollout ("cuda" for the paper preset where a GPU is
     available); the environment stays on the CPU. Only the CPU is tested here.
 
-    Writes ``progress.csv``, TensorBoard events (with tensorboardX) and ``checkpoint.pt`` into
-    ``out_dir``: every ``checkpoint_every`` steps, at the end, and on Ctrl-C or SIGTERM before
-    the interruption propagates. The same seed gives the same run.
+    Writes ``progress.csv``, TensorBoard events (with tensorboardX), ``checkpoint.pt`` and
+    ``training-state.pt`` into ``out_dir``: every ``checkpoint_every`` steps, at the end, at
+    the first update boundary after ``stop_after_s`` seconds (then :func:`resume` continues),
+    and on Ctrl-C or SIGTERM before the interruption propagates. The same seed gives the same
+    run.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    checkpoint = out / CHECKPOINT_NAME
+    with _torch_threads(train_config.threads):
+        torch.manual_seed(_torch_seed(train_config.seed, "init"))
+        policy = InspectionPolicy(policy_config).to(device)
+        env = make_env(train_config.num_envs, train_config.seed)
+        run = _Run(env, policy, train_config, env_config)
+        return _drive(run, out, ProgressLog(out), progress, stop_after_s)
+
+
+def resume(
+    state: TrainingState,
+    out_dir: str | Path,
+    *,
+    progress: Callable[[ProgressRow], None] | None = None,
+    stop_after_s: float | None = None,
+) -> TrainResult:
+    """Continue the run ``state`` saved (:func:`~.training_state.read_training_state` of
+    ``out_dir``), as if it had never stopped; ``progress.csv`` goes on from its rows."""
+    out = Path(out_dir)
+    with _torch_threads(state.train_config.threads):
+        run = _Run.restored(state)
+        return _drive(run, out, ProgressLog(out, state.rows), progress, stop_after_s)
+
+
+@contextlib.contextmanager
+def _torch_threads(count: int) -> Iterator[None]:
     threads = torch.get_num_threads()
-    torch.set_num_threads(train_config.threads)
-    torch.manual_seed(_torch_seed(train_config.seed, "init"))
-    policy = InspectionPolicy(policy_config).to(device)
-    env = make_env(train_config.num_envs, train_config.seed)
-    log = ProgressLog(out)
-    start = time.perf_counter()
-    run = None
+    torch.set_num_threads(count)
     try:
-        run = _Run(env, policy, train_config)
-        saved_at = 0
-        for update in range(1, train_config.updates + 1):
-            stats = run.collect()
-            losses = run.update((update - 1) / train_config.updates)
-            row = _progress_row(update, run, stats, losses, time.perf_counter() - start)
-            log.add(row)
-            if progress is not None:
-                progress(row)
-            if run.steps - saved_at >= train_config.checkpoint_every:
-                save_checkpoint(checkpoint, policy, train_config, run.steps)
-                saved_at = run.steps
-        save_checkpoint(checkpoint, policy, train_config, run.steps)
-    except KeyboardInterrupt:
-        with deferred_signals():  # a second Ctrl-C must not cut the last checkpoint short
-            save_checkpoint(checkpoint, policy, train_config, run.steps if run else 0)
-        raise
+        yield
     finally:
-        log.close()
-        env.close()
         torch.set_num_threads(threads)
+
+
+def _drive(
+    run: _Run,
+    out: Path,
+    log: ProgressLog,
+    progress: Callable[[ProgressRow], None] | None,
+    stop_after_s: float | None,
+) -> TrainResult:
+    """Run updates to the budget or the time limit, saving as :func:`train` says."""
+    start = time.perf_counter()
+    with stop_on_signals():  # SIGTERM as Ctrl-C, and both held back until an update's end
+        try:
+            if not run.whole:
+                run.begin()
+            finished = _updates(run, out, log, progress, start=start, stop_after_s=stop_after_s)
+            _save(run, out, log)
+        except KeyboardInterrupt:
+            if run.whole:  # else the last saved state stays: it is the last whole one
+                _save(run, out, log)
+            raise
+        finally:
+            log.close()
+            run.env.close()
     return TrainResult(
         steps=run.steps,
-        updates=train_config.updates,
+        updates=run.updates,
         wall_s=time.perf_counter() - start,
-        checkpoint=checkpoint,
+        checkpoint=out / CHECKPOINT_NAME,
         last=log.rows[-1] if log.rows else None,
         tensorboard=log.writer is not None,
+        finished=finished,
     )
 
 
-def _progress_row(
-    update: int, run: _Run, stats: EpisodeStats, losses: dict[str, float], wall_s: float
-) -> ProgressRow:
+def _updates(
+    run: _Run,
+    out: Path,
+    log: ProgressLog,
+    progress: Callable[[ProgressRow], None] | None,
+    *,
+    start: float,
+    stop_after_s: float | None,
+) -> bool:
+    """Updates until the budget is spent (True) or ``stop_after_s`` has passed (False)."""
+    config, before = run.config, run.wall_s
+    while run.updates < config.updates:
+        with deferred_signals():  # a stop signal waits for the boundary, where the state is whole
+            run.whole = False
+            stats = run.collect()
+            losses = run.update(run.updates / config.updates)
+            run.updates += 1
+            run.wall_s = before + time.perf_counter() - start
+            row = _progress_row(run, stats, losses)
+            log.add(row)
+            run.whole = True
+        if progress is not None:
+            progress(row)
+        if run.steps - run.saved_at >= config.checkpoint_every:
+            _save(run, out, log)
+        if stop_after_s is not None and time.perf_counter() - start >= stop_after_s:
+            return run.updates >= config.updates
+    return True
+
+
+def _save(run: _Run, out: Path, log: ProgressLog) -> None:
+    """The training state and the checkpoint, at an update boundary."""
+    with deferred_signals():  # a second Ctrl-C must not cut the last save short
+        run.saved_at = run.steps
+        save_training_state(out / TRAINING_STATE_NAME, run.state(tuple(log.rows)))
+        save_checkpoint(out / CHECKPOINT_NAME, run.policy, run.config, run.steps, run.env_config)
+
+
+def _progress_row(run: _Run, stats: EpisodeStats, losses: dict[str, float]) -> ProgressRow:
+    wall_s = run.wall_s
     return ProgressRow(
-        update=update,
+        update=run.updates,
         steps=run.steps,
         wall_s=wall_s,
         steps_per_s=run.steps / wall_s if wall_s > 0 else math.nan,

@@ -10,7 +10,7 @@ import csv
 import dataclasses
 import io
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -66,11 +66,13 @@ class EpisodeStats:
 
 class ProgressLog:
     """``progress.csv`` (rewritten atomically after each update) and, when tensorboardX is
-    installed, TensorBoard event files in the same folder."""
+    installed, TensorBoard event files in the same folder. A resumed run starts from the
+    ``rows`` its saved state logged, so rows written after that state are replaced, not
+    repeated."""
 
-    def __init__(self, out_dir: Path):
+    def __init__(self, out_dir: Path, rows: Sequence[ProgressRow] = ()):
         self.path = out_dir / "progress.csv"
-        self.rows: list[ProgressRow] = []
+        self.rows: list[ProgressRow] = list(rows)
         try:
             from tensorboardX import SummaryWriter  # noqa: PLC0415 - optional ('rl' extra)
         except ImportError:

@@ -1,11 +1,9 @@
 """Training rooms of 004 Sec III-E: primitive obstacles around one semantic object.
 
 A room is a closed box (floor, four walls, ceiling) holding K obstacles (boxes, cylinders and
-spheres of random size, position and orientation) and one semantic object: an upright cylinder
-whose surface is split into N_f = 60 faces (12 sectors x 4 bands on the side, 12 sectors of
-the top; the bottom rests on the floor and cannot be seen, so it is not scored). The paper's
-object is a cuboid or other primitive with 60 faces; a cylinder keeps every face inspectable
-from some free viewpoint, so 100 % coverage is feasible in an empty room.
+spheres of random size, position and orientation) and one semantic object of N_f = 60 faces
+(:mod:`.targets`: a cylinder, box, sphere or T-pipe). Rooms are 10 x 10 x 4 m (Table I) or, with
+``EnvConfig.room_size_range``, drawn per room (Sec III-E: [4, 20] x [4, 20] x [2, 8] m).
 
 Every solid is kept both as triangles (for the ray caster) and as an analytic shape, so the
 robot's clearance to everything in the room is exact and cheap (:func:`clearance`).
@@ -22,33 +20,34 @@ from numpy.typing import NDArray
 
 from seminspect.core.errors import InvalidInputError
 from seminspect.geometry.transforms import matrix_from_euler_xyz
+from seminspect.missions.learning.env_config import EnvConfig, TargetShape
+from seminspect.missions.learning.solids import (
+    BOX,
+    CYLINDER,
+    SPHERE,
+    Solids,
+    clearance,
+    surface_gap,
+)
+from seminspect.missions.learning.targets import TARGET_FACES, Target, make_target
 from seminspect.worlds.shapes import Piece, box, cylinder, sphere
 
-#: Shape codes of :class:`Solids`.
-BOX, CYLINDER, SPHERE = 0, 1, 2
-#: Faces of the semantic object (004 Sec III-E: N_f = 60).
-TARGET_SECTORS, TARGET_BANDS = 12, 4
-TARGET_FACES = TARGET_SECTORS * (TARGET_BANDS + 1)
+__all__ = [
+    "BOX",
+    "CYLINDER",
+    "SPHERE",
+    "TABLE1_OBSTACLES",
+    "TARGET_FACES",
+    "Room",
+    "Solids",
+    "clearance",
+    "sample_room",
+    "side_by_side",
+    "stack_solids",
+]
+
 #: Obstacle counts of 004 Table I.
 TABLE1_OBSTACLES = (0, 4, 9, 14, 19)
-
-
-@dataclass(frozen=True)
-class Solids:
-    """Analytic solids of one room: shape code, centre, rotation (local to room) and size.
-
-    ``size`` holds half extents for a box, (radius, half height, 0) for a cylinder along its
-    local z axis and (radius, 0, 0) for a sphere.
-    """
-
-    kind: NDArray[np.int8]
-    centre: NDArray[np.float64]
-    rotation: NDArray[np.float64]
-    size: NDArray[np.float64]
-
-    def rows(self, index: NDArray[np.int64]) -> Solids:
-        """The solids of the rooms ``index`` of a batch (arrays with a leading room axis)."""
-        return Solids(self.kind[index], self.centre[index], self.rotation[index], self.size[index])
 
 
 @dataclass(frozen=True)
@@ -56,7 +55,9 @@ class Room:
     """One sampled room: its solids, triangles and the robot's start.
 
     ``face_of_triangle`` gives the target face (0..59) of each triangle, or -1 for triangles of
-    the room and its obstacles. The target is ``solids`` row 0.
+    the room and its obstacles. The target is the first ``target_solids`` rows of ``solids``
+    (two for a T-pipe); ``target_box`` bounds it (low, high corner); ``target_radius`` is its
+    horizontal reach from the vertical axis through the box's centre.
     """
 
     size: NDArray[np.float64]
@@ -66,35 +67,14 @@ class Room:
     face_of_triangle: NDArray[np.int64]
     start: NDArray[np.float64]
     start_yaw: float
+    shape: TargetShape
+    target_solids: int
+    target_box: NDArray[np.float64]
+    target_radius: float
 
     @property
     def obstacle_count(self) -> int:
-        return len(self.solids.kind) - 1
-
-
-def clearance(
-    points: NDArray[np.float64], solids: Solids, room_size: NDArray[np.float64]
-) -> NDArray[np.float64]:
-    """Distance from each point to the nearest surface of its room (walls or solids).
-
-    Exact signed distances of boxes, cylinders and spheres (negative inside a solid).
-    ``points`` is ``(N, 3)``; the solids' arrays carry a leading ``N`` (one room per point, as in
-    a batch of environments) or none (one room shared by every point).
-    """
-    pts = np.atleast_2d(points)
-    walls = np.minimum(pts, room_size - pts).min(axis=1)
-    local = np.einsum("...kji,...kj->...ki", solids.rotation, pts[:, None, :] - solids.centre)
-    half = np.broadcast_to(solids.size, local.shape)
-    box_q = np.abs(local) - half
-    box_d = np.linalg.norm(np.maximum(box_q, 0.0), axis=-1) + np.minimum(box_q.max(axis=-1), 0.0)
-    radial = np.hypot(local[..., 0], local[..., 1]) - half[..., 0]
-    axial = np.abs(local[..., 2]) - half[..., 1]
-    cyl_q = np.stack([radial, axial], axis=-1)
-    cyl_d = np.linalg.norm(np.maximum(cyl_q, 0.0), axis=-1) + np.minimum(cyl_q.max(axis=-1), 0.0)
-    sph_d = np.linalg.norm(local, axis=-1) - half[..., 0]
-    kind = np.broadcast_to(solids.kind, sph_d.shape)
-    solid_d = np.where(kind == BOX, box_d, np.where(kind == CYLINDER, cyl_d, sph_d))
-    return np.minimum(walls, solid_d.min(axis=-1, initial=np.inf))
+        return len(self.solids.kind) - self.target_solids
 
 
 def stack_solids(rooms: list[Room]) -> Solids:
@@ -134,32 +114,6 @@ def _shell(size: NDArray) -> tuple[NDArray, NDArray]:
     return piece.vertices, piece.faces[:, ::-1]
 
 
-def target_mesh(radius: float, height: float) -> tuple[NDArray, NDArray, NDArray]:
-    """Side (sectors x bands quads) and top cap (sector triangles) of the semantic cylinder.
-
-    Returns vertices, triangles and the face (0..59) of each triangle, centred on the origin.
-    """
-    angles = np.linspace(0.0, 2.0 * math.pi, TARGET_SECTORS, endpoint=False)
-    heights = np.linspace(-height / 2, height / 2, TARGET_BANDS + 1)
-    ring = np.stack([radius * np.cos(angles), radius * np.sin(angles)], axis=1)
-    side = np.array([(x, y, z) for z in heights for x, y in ring])
-    top_centre = np.array([[0.0, 0.0, height / 2]])
-    vertices = np.vstack([side, top_centre])
-    tris, faces = [], []
-    for band in range(TARGET_BANDS):
-        for s in range(TARGET_SECTORS):
-            a, b = band * TARGET_SECTORS + s, band * TARGET_SECTORS + (s + 1) % TARGET_SECTORS
-            c, d = a + TARGET_SECTORS, b + TARGET_SECTORS
-            face = band * TARGET_SECTORS + s
-            tris += [(a, b, d), (a, d, c)]
-            faces += [face, face]
-    top_ring, centre = TARGET_BANDS * TARGET_SECTORS, len(side)
-    for s in range(TARGET_SECTORS):
-        tris.append((top_ring + s, top_ring + (s + 1) % TARGET_SECTORS, centre))
-        faces.append(TARGET_BANDS * TARGET_SECTORS + s)
-    return vertices, np.array(tris, dtype=np.int64), np.array(faces, dtype=np.int64)
-
-
 @cache
 def _unit_mesh(kind: int) -> Piece:
     """Unit cylinder (radius 1, half height 1) or unit sphere, meshed once and scaled per use."""
@@ -187,22 +141,34 @@ def _bounding_radius(kind: int, size: NDArray) -> float:
 def sample_room(
     rng: np.random.Generator,
     obstacles: int,
-    size: tuple[float, float, float] = (10.0, 10.0, 4.0),
+    config: EnvConfig | None = None,
     robot_clearance: float = 0.6,
     orbit_gap: float = 2.2,
 ) -> Room:
-    """A room of ``size`` metres with ``obstacles`` primitives, the target and a free start.
+    """A room with ``obstacles`` primitives, the target and a free start, as ``config`` says.
 
-    Obstacles may occlude the target (as in the paper) but leave a gap of at least
-    ``robot_clearance`` around it, so its faces are not walled in; the start is at least that
-    far from everything. The target stands ``orbit_gap`` from the walls where the room allows,
-    so a robot can circle it at the reference distance.
+    Its size is ``config.room_size`` or drawn from ``config.room_size_range``; its target's
+    shape is drawn from ``config.target_shapes`` (no draw for a single shape). Obstacles may
+    occlude the target (as in the paper); ``config.obstacle_rule`` keeps them clear of it
+    (:func:`_add_obstacle`). The start is at least ``robot_clearance`` from everything. The
+    target stands ``orbit_gap`` from the walls where the room allows, so a robot can circle it
+    at the reference distance.
     """
-    extent = _checked_extent(obstacles, size)
+    cfg = config or EnvConfig()
+    extent = _room_extent(rng, obstacles, cfg)
+    shapes = cfg.target_shapes
+    shape = shapes[int(rng.integers(len(shapes)))] if len(shapes) > 1 else shapes[0]
+    target = make_target(rng, shape, extent, orbit_gap)
     parts = _RoomParts()
-    target_reach = _add_target(parts, rng, extent, orbit_gap) + robot_clearance
+    own = target.solids
+    for i, kind in enumerate(own.kind):
+        parts.add_solid(int(kind), own.centre[i], own.rotation[i], own.size[i])
+    parts.add_mesh(target.vertices, target.triangles, target.faces)
+    # "surface": the robot's width between the surfaces; "target-sphere" (policy v1): the
+    # obstacle's bounding sphere kept robot_clearance beyond the target's
+    gap = 2.0 * cfg.robot_radius if cfg.obstacle_rule == "surface" else None
     for _ in range(obstacles):
-        _add_obstacle(parts, rng, extent, target_reach)
+        _add_obstacle(parts, rng, extent, target, gap=gap, reach=target.reach + robot_clearance)
     parts.add_mesh(*_shell(extent))
     solids = parts.solids()
     start = _free_start(rng, solids, extent, robot_clearance)
@@ -214,15 +180,25 @@ def sample_room(
         face_of_triangle=np.concatenate(parts.faces),
         start=start,
         start_yaw=float(rng.uniform(-math.pi, math.pi)),
+        shape=shape,
+        target_solids=len(target.solids.kind),
+        target_box=target.box,
+        target_radius=target.radius,
     )
 
 
-def _checked_extent(obstacles: int, size: tuple[float, float, float]) -> NDArray[np.float64]:
+def _room_extent(rng: np.random.Generator, obstacles: int, config: EnvConfig) -> NDArray:
+    """The room's size: fixed, or drawn uniformly per axis (004 Sec III-E)."""
     if obstacles < 0:
         raise InvalidInputError(f"obstacle count must be >= 0, got {obstacles}")
-    extent = np.asarray(size, dtype=np.float64)
-    if extent.shape != (3,) or np.any(extent < (4.0, 4.0, 2.0)):
-        raise InvalidInputError(f"room must be at least 4 x 4 x 2 m, got {size}")
+    if config.room_size_range is None:
+        extent = np.asarray(config.room_size, dtype=np.float64)
+    else:
+        low, high = np.array(config.room_size_range, dtype=np.float64).T
+        extent = rng.uniform(low, high)
+    if np.any(extent < (4.0, 4.0, 2.0)):
+        size = " x ".join(f"{x:g}" for x in extent.round(2))
+        raise InvalidInputError(f"room must be at least 4 x 4 x 2 m, got {size} m")
     return extent
 
 
@@ -262,31 +238,42 @@ class _RoomParts:
         )
 
 
-def _add_target(
-    parts: _RoomParts, rng: np.random.Generator, extent: NDArray, orbit_gap: float
-) -> float:
-    """Place the semantic cylinder ``orbit_gap`` from the walls; returns its bounding radius."""
-    radius, height = rng.uniform(0.3, 0.8), rng.uniform(1.0, min(2.5, extent[2] - 1.0))
-    margin = np.minimum(radius + orbit_gap, extent[:2] / 2)
-    centre = np.array([*rng.uniform(margin, extent[:2] - margin), height / 2])
-    parts.add_solid(CYLINDER, centre, np.eye(3), np.array([radius, height / 2, 0.0]))
-    vertices, triangles, faces = target_mesh(radius, height)
-    parts.add_mesh(vertices + centre, triangles, faces)
-    return math.hypot(radius, height / 2)
-
-
 def _add_obstacle(
-    parts: _RoomParts, rng: np.random.Generator, extent: NDArray, target_reach: float
+    parts: _RoomParts,
+    rng: np.random.Generator,
+    extent: NDArray,
+    target: Target,
+    *,
+    gap: float | None,
+    reach: float,
 ) -> None:
-    """A random primitive, placed (within 32 tries) so that it stays ``target_reach`` clear of
-    the target's centre; randomly turned."""
+    """A random primitive, placed anywhere and randomly turned, within 32 tries.
+
+    With a ``gap`` (rule "surface") a try is kept when the obstacle's surface stays ``gap``
+    from the target's (:func:`~.solids.surface_gap`); an obstacle no try places is left out.
+    Without one (rule "target-sphere", policy v1's draws in its order) a try is kept when the
+    obstacle's bounding sphere stays ``reach`` from the target's centre, else the last
+    try stands.
+    """
     kind, size, vertices, triangles = _obstacle(rng)
-    needed = _bounding_radius(kind, size) + target_reach
-    for _attempt in range(32):
-        centre = rng.uniform(0.0, extent)
-        if np.linalg.norm(centre - parts.centres[0]) > needed:
-            break
-    rotation = matrix_from_euler_xyz(rng.uniform(-math.pi, math.pi, size=3))
+    if gap is None:
+        needed = _bounding_radius(kind, size) + reach
+        for _attempt in range(32):
+            centre = rng.uniform(0.0, extent)
+            if np.linalg.norm(centre - target.middle) > needed:
+                break
+        rotation = matrix_from_euler_xyz(rng.uniform(-math.pi, math.pi, size=3))
+    else:
+        apart = _bounding_radius(kind, size) + target.reach + gap  # bounding spheres: clear
+        for _attempt in range(32):
+            centre = rng.uniform(0.0, extent)
+            rotation = matrix_from_euler_xyz(rng.uniform(-math.pi, math.pi, size=3))
+            solid = Solids(np.array([kind], np.int8), centre[None], rotation[None], size[None])
+            far = np.linalg.norm(centre - target.middle) > apart
+            if far or surface_gap(solid, target.solids) >= gap:
+                break
+        else:
+            return
     parts.add_solid(kind, centre, rotation, size)
     parts.add_mesh(vertices @ rotation.T + centre, triangles)
 

@@ -2,7 +2,8 @@
 
 The body frame has x forward, y left and z up; the vehicle stays level, so a ray reaches the
 world frame by the robot's heading alone (:func:`~seminspect.geometry.transforms.rotate_xy`).
-:func:`sensor_rays` is compiled: it picks, room by room, the camera pixels worth casting.
+:func:`sensor_rays` is compiled: it picks, room by room, the camera pixels worth casting; blocks
+of rooms may be built on several threads.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
+from seminspect.core.threads import run_dealt
 from seminspect.geometry.transforms import rotate_xy
 
 #: rotate_xy compiled, typed for the scalars the kernels give it.
@@ -87,76 +89,105 @@ def noisy_ranges(
 
 
 @numba.njit(cache=True)
-def _hits_upright_cylinder(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
+def _slab(
+    o: float, d: float, low: float, high: float, span: tuple[float, float]
+) -> tuple[float, float]:
+    """The part of the ray's parameter ``span`` within one axis' slab, with 1 mm of slack (the
+    caster turns the rays in float32); empty when its low end passes its high end."""
+    low, high = low - 1e-3, high + 1e-3
+    if abs(d) < 1e-12:
+        return span if low <= o <= high else (1.0, 0.0)
+    t1, t2 = (low - o) / d, (high - o) / d
+    return max(span[0], min(t1, t2)), min(span[1], max(t1, t2))
+
+
+@numba.njit(cache=True)
+def _hits_box(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
     ox: float,
     oy: float,
     oz: float,
     dx: float,
     dy: float,
     dz: float,
-    cx: float,
-    cy: float,
-    cz: float,
-    radius: float,
-    half: float,
+    box: NDArray[np.float64],
     reach: float,
 ) -> bool:
-    """Whether a ray meets an upright cylinder within ``reach`` (a conservative bound test)."""
-    t_low, t_high = 0.0, reach
-    if abs(dz) < 1e-12:
-        if abs(oz - cz) > half:
-            return False
-    else:
-        t1, t2 = (cz - half - oz) / dz, (cz + half - oz) / dz
-        t_low, t_high = max(t_low, min(t1, t2)), min(t_high, max(t1, t2))
-    px, py = ox - cx, oy - cy
-    a = dx * dx + dy * dy
-    b = px * dx + py * dy
-    c = px * px + py * py - radius * radius
-    if a < 1e-12:
-        return c <= 0.0 and t_low <= t_high
-    disc = b * b - a * c
-    if disc < 0.0:
-        return False
-    root = math.sqrt(disc)
-    return max(t_low, (-b - root) / a) <= min(t_high, (-b + root) / a)
+    """Whether a ray may meet an axis-aligned box ``(low, high)`` within ``reach`` (slab test)."""
+    span = _slab(ox, dx, box[0, 0], box[1, 0], (0.0, reach))
+    span = _slab(oy, dy, box[0, 1], box[1, 1], span)
+    span = _slab(oz, dz, box[0, 2], box[1, 2], span)
+    return span[0] <= span[1]
 
 
-@numba.njit(cache=True)
-def sensor_rays(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
+#: Below this many rooms per thread, dealing a kernel's rooms out costs more than it saves.
+MIN_ROOMS_PER_THREAD = 2
+
+Rays = tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float32], NDArray[np.float32]]
+
+
+def sensor_rays(  # noqa: PLR0917 - the kernel's arrays, positionally
     origin: NDArray[np.float64],
     yaw: NDArray[np.float64],
     camera: NDArray[np.float32],
     lidar: NDArray[np.float32],
     mapped: NDArray[np.bool_],
-    target_centre: NDArray[np.float64],
-    target_size: NDArray[np.float64],
+    target_box: NDArray[np.float64],
     reach: float,
-) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float32], NDArray[np.float32]]:
+    threads: int = 1,
+) -> Rays:
     """The rays each room needs, grouped by room: (row, ray id, origin, direction).
 
-    Camera pixels are cast when they may see the target (their ray meets its bounding
-    cylinder) or when they belong to the mapping subset ``mapped``; every LiDAR beam is cast.
+    Camera pixels are cast when they may see the target (their ray meets its axis-aligned
+    bound ``target_box``, ``(rooms, 2, 3)``: low and high corner, in the origins' frame) or
+    when they belong to the mapping subset ``mapped``; every LiDAR beam is cast.
     A pixel left out can only see something other than the target, so the masked depth and
     the face reward are exact; only the map takes fewer (coarser) camera returns. Ray ids
-    number the camera pixels first, then the LiDAR beams.
+    number the camera pixels first, then the LiDAR beams. With ``threads`` > 1 blocks of rooms
+    are built on that many threads (:func:`~seminspect.core.threads.run_dealt`); the rays are
+    the same, in the same order.
     """
-    rows, ids = _rays_to_cast(
-        origin, yaw, camera, lidar.shape[0], mapped, target_centre, target_size, reach
-    )
+    parts: dict[int, Rays] = {}
+
+    def build(block: slice) -> None:
+        if block.start == block.stop:  # more blocks than rooms: an empty one, keyed like the next
+            return
+        rows, ids, starts, dirs = _room_rays(
+            origin[block], yaw[block], camera, lidar, mapped, target_box[block], reach
+        )
+        parts[block.start] = (rows + block.start, ids, starts, dirs)
+
+    run_dealt(build, len(origin), threads, MIN_ROOMS_PER_THREAD)
+    if len(parts) == 1:
+        return parts[0]
+    blocks = [parts[start] for start in sorted(parts)]
+    row, ray, start, direction = (np.concatenate(column) for column in zip(*blocks, strict=True))
+    return row, ray, start, direction
+
+
+@numba.njit(cache=True, nogil=True)
+def _room_rays(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
+    origin: NDArray[np.float64],
+    yaw: NDArray[np.float64],
+    camera: NDArray[np.float32],
+    lidar: NDArray[np.float32],
+    mapped: NDArray[np.bool_],
+    target_box: NDArray[np.float64],
+    reach: float,
+) -> Rays:
+    """:func:`sensor_rays` of a block of rooms, on one thread."""
+    rows, ids = _rays_to_cast(origin, yaw, camera, lidar.shape[0], mapped, target_box, reach)
     starts, dirs = _world_rays(rows, ids, origin, yaw, camera, lidar)
     return rows, ids, starts, dirs
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _rays_to_cast(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
     origin: NDArray[np.float64],
     yaw: NDArray[np.float64],
     camera: NDArray[np.float32],
     n_lidar: int,
     mapped: NDArray[np.bool_],
-    target_centre: NDArray[np.float64],
-    target_size: NDArray[np.float64],
+    target_box: NDArray[np.float64],
     reach: float,
 ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """(room row, ray id) of the mapping pixels, the pixels that may see the target, the beams."""
@@ -167,15 +198,11 @@ def _rays_to_cast(  # noqa: PLR0917 - a compiled kernel takes its arrays positio
     for r in range(origin.shape[0]):
         c, s = math.cos(yaw[r]), math.sin(yaw[r])
         ox, oy, oz = origin[r, 0], origin[r, 1], origin[r, 2]
-        cx, cy, cz = target_centre[r, 0], target_centre[r, 1], target_centre[r, 2]
-        radius, half = target_size[r, 0] + 1e-3, target_size[r, 1] + 1e-3
         for k in range(n_cam):
             keep = mapped[k]
             if not keep:
                 dx, dy = _rotate_xy(c, s, camera[k, 0], camera[k, 1])
-                keep = _hits_upright_cylinder(
-                    ox, oy, oz, dx, dy, camera[k, 2], cx, cy, cz, radius, half, reach
-                )
+                keep = _hits_box(ox, oy, oz, dx, dy, camera[k, 2], target_box[r], reach)
             if keep:
                 rows[count], ids[count] = r, k
                 count += 1
@@ -185,7 +212,7 @@ def _rays_to_cast(  # noqa: PLR0917 - a compiled kernel takes its arrays positio
     return rows[:count], ids[:count]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _world_rays(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
     rows: NDArray[np.int64],
     ids: NDArray[np.int64],

@@ -1,21 +1,27 @@
 """Markdown tables of learned-inspection evaluations beside 004 Tables I-III.
 
-Each table puts the paper's rows first and ours under them, one measure (coverage, crash,
-timeout) per block, so a reader compares numbers in the same column. Percentages have one
-decimal, as in the paper.
+Each table puts the paper's rows first and ours under them, one measure per block, so a reader
+compares numbers in the same column: coverage lenient (within ``inspect_range``) and strict (of
+the feasible faces, with its 95 % interval), the distance score, crash % (with its Wilson 95 %
+interval) and timeout %. The paper reports one coverage; it stands beside both of ours.
+Percentages have one decimal, as in the paper. :func:`generalisation_markdown` shows policies
+on object shapes, marking those they never met in training.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
+from typing import NamedTuple
 
+from seminspect.missions.learning.env_config import TARGET_SHAPES
 from seminspect.missions.learning.evaluation import (
     PAPER_TABLE1,
     PAPER_TABLE2,
     PAPER_TABLE3,
     EvaluationResult,
     ObstacleResult,
+    interval_text,
 )
 
 #: The sections of docs/reproduction.md, and the stored evaluations (file stems) each needs.
@@ -27,12 +33,36 @@ NEEDS = {
 }
 #: 004 Tables II and III are measured in rooms with nine obstacles.
 ABLATION_OBSTACLES = 9
-MEASURES = (("coverage %", "coverage_pct"), ("crash %", "crash_pct"), ("timeout %", "timeout_pct"))
+
+
+class Measure(NamedTuple):
+    """One block of a table: its label, the paper's column (None: 004 has none), our cell."""
+
+    label: str
+    paper: int | None
+    cell: Callable[[ObstacleResult], str]
+
+
+STRICT = Measure(
+    "strict coverage %", 0, lambda r: interval_text(r.strict_coverage_pct, r.strict_coverage_ci)
+)
+CRASH = Measure("crash %", 1, lambda r: interval_text(r.crash_pct, r.crash_ci))
+MEASURES = (
+    Measure("coverage % (lenient)", 0, lambda r: f"{r.coverage_pct:.1f}"),
+    STRICT,
+    Measure("distance score", None, lambda r: f"{r.distance_score:.2f}"),
+    CRASH,
+    Measure("timeout %", 2, lambda r: f"{r.timeout_pct:.1f}"),
+)
 
 
 def _cells(values: Sequence[float | str | None]) -> str:
     """Table cells: one decimal for numbers, text as given, "-" for a missing paper value."""
     return " | ".join("-" if v is None else v if isinstance(v, str) else f"{v:.1f}" for v in values)
+
+
+def _paper(row: tuple[float, float, float] | None, measure: Measure) -> float | None:
+    return None if row is None or measure.paper is None else row[measure.paper]
 
 
 def table1_markdown(results: Mapping[str, EvaluationResult]) -> str:
@@ -46,12 +76,13 @@ def table1_markdown(results: Mapping[str, EvaluationResult]) -> str:
         "| measure | controller | " + " | ".join(f"{k} obstacles" for k in counts) + " |",
         "|---|---|" + "---:|" * len(counts),
     ]
-    for index, (label, field) in enumerate(MEASURES):
-        paper = [PAPER_TABLE1[k][index] if k in PAPER_TABLE1 else None for k in counts]
-        lines.append(f"| {label} | 004 (Aerial Gym, GPU) | {_cells(paper)} |")
+    for measure in MEASURES:
+        if measure.paper is not None:
+            paper = [_paper(PAPER_TABLE1.get(k), measure) for k in counts]
+            lines.append(f"| {measure.label} | 004 (Aerial Gym, GPU) | {_cells(paper)} |")
         for name, result in results.items():
-            ours = [getattr(result.at(k), field) for k in counts]
-            lines.append(f"| {label} | {name} | {_cells(ours)} |")
+            ours = [measure.cell(result.at(k)) for k in counts]
+            lines.append(f"| {measure.label} | {name} | {_cells(ours)} |")
     episodes = {row.episodes for result in results.values() for row in result.results}
     lines.append("")
     lines.append(f"Episodes per cell: {', '.join(str(n) for n in sorted(episodes))}.")
@@ -72,18 +103,56 @@ def ablation_markdown(
         "| measure | source | " + " | ".join(columns) + " |",
         "|---|---|" + "---:|" * len(columns),
     ]
-    for index, (label, field) in enumerate(MEASURES):
-        lines.append(f"| {label} | 004 | {_cells([paper[c][index] for c in columns])} |")
-        row = [_measure(ours.get(c), field) for c in columns]
-        lines.append(f"| {label} | ours | {_cells(row)} |")
+    for measure in MEASURES:
+        if measure.paper is not None:
+            values = [_paper(paper[c], measure) for c in columns]
+            lines.append(f"| {measure.label} | 004 | {_cells(values)} |")
+        row = [_measure(ours.get(c), measure) for c in columns]
+        lines.append(f"| {measure.label} | ours | {_cells(row)} |")
     episodes = sorted({r.episodes for r in ours.values() if r is not None})
     lines.append("")
     lines.append(f"Episodes per cell: {', '.join(str(n) for n in episodes)}.")
     return "\n".join(lines)
 
 
-def _measure(result: ObstacleResult | None, field: str) -> float | str:
-    return "not trained" if result is None else float(getattr(result, field))
+def _measure(result: ObstacleResult | None, measure: Measure) -> str:
+    return "not trained" if result is None else measure.cell(result)
+
+
+def generalisation_markdown(
+    results: Mapping[str, Mapping[str, EvaluationResult]],
+    trained: Mapping[str, Sequence[str]],
+    obstacles: int = ABLATION_OBSTACLES,
+) -> str:
+    """Strict coverage and crash % of each policy (rows) on each object shape (columns).
+
+    ``results`` maps a policy label to its evaluations by shape, ``trained`` the label to the
+    shapes its training rooms held: a shape outside them is marked "(unseen)", the test of a
+    policy trained without a shape and evaluated on it. A shape not evaluated shows "-".
+    """
+    shapes = [s for s in TARGET_SHAPES if any(s in by_shape for by_shape in results.values())]
+    lines = [
+        "| measure | policy | " + " | ".join(shapes) + " |",
+        "|---|---|" + "---:|" * len(shapes),
+    ]
+    for measure in (STRICT, CRASH):
+        for name, by_shape in results.items():
+            cells = [
+                None
+                if shape not in by_shape
+                else measure.cell(by_shape[shape].at(obstacles))
+                + ("" if shape in trained[name] else " (unseen)")
+                for shape in shapes
+            ]
+            lines.append(f"| {measure.label} | {name} | {_cells(cells)} |")
+    episodes = sorted(
+        {r.at(obstacles).episodes for by_shape in results.values() for r in by_shape.values()}
+    )
+    lines.append("")
+    lines.append(
+        f"{obstacles} obstacles; episodes per cell: {', '.join(str(n) for n in episodes)}."
+    )
+    return "\n".join(lines)
 
 
 def load_evaluations(directory: Path) -> dict[str, EvaluationResult]:
