@@ -2,7 +2,7 @@
 #   make mission     install seminspect, compile its kernels, run the default inspection mission
 #   make test        install seminspect with test tools and run the test suite
 #   make docs        build the API reference from the docstrings into build/docs
-#   make reproduce   regenerate every measured table of docs/reproduction.md (45 minutes on 2 cores)
+#   make reproduce   regenerate every measured table of docs/reproduction.md (about 79 minutes on 2 cores)
 #   make lock        rewrite requirements.lock from the versions installed in .venv
 # Installs take the exact versions of requirements.lock (the ones behind the published
 # figures); pyproject.toml keeps version ranges for people who use seminspect as a library.

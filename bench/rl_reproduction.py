@@ -11,7 +11,9 @@ document still matches them.
 * ``rl-table1``: the shipped policy, the orbit and the random controllers at 0/4/9/14/19
   obstacles (004 Table I);
 * ``rl-table2``: the policy trained without the SVS map beside the shipped one, 9 obstacles;
-* ``rl-table3``: the policy trained without a GRU beside the shipped one (GRU 128), 9 obstacles.
+* ``rl-table3``: the policy trained without a GRU beside the shipped one (GRU 128), 9 obstacles;
+* ``rl-shapes``: the shipped policy and the orbit on the four object shapes, 9 obstacles (a
+  shape the policy's training rooms never held is marked unseen).
 
 With Table I it also draws ``docs/images/rl-coverage.png``: coverage against time of the three
 controllers at each obstacle count (mean and 5th-95th percentile, as 004 Fig 5), and
@@ -34,6 +36,7 @@ from pathlib import Path
 from seminspect.core.io import file_sha256
 from seminspect.missions.learning.agent import load_controller, shipped_policy_path
 from seminspect.missions.learning.baselines import Controller, OrbitController, RandomController
+from seminspect.missions.learning.env_config import TargetShape
 from seminspect.missions.learning.evaluation import (
     EvaluationResult,
     controller_evaluation_config,
@@ -46,6 +49,7 @@ from seminspect.report.rl import coverage_figure, training_figure
 from seminspect.studies.learning.tables import (
     ABLATION_OBSTACLES,
     NEEDS,
+    OTHER_SHAPES,
     SECTIONS,
     load_evaluations,
     reproduction_sections,
@@ -66,14 +70,24 @@ TRAINING_LOGS = {
 }
 SEED, EPISODES, ENVS = 0, 100, 50
 
-#: Evaluation file -> (baseline factory or checkpoint file, obstacle counts, policy label).
-EVALUATIONS: dict[str, tuple[Callable[[], Controller] | Path, tuple[int, ...], str]] = {
-    "table1-learned": (shipped_policy_path(), TABLE1_OBSTACLES, "learned (shipped)"),
-    "table1-orbit": (OrbitController, TABLE1_OBSTACLES, "orbit"),
-    "table1-random": (lambda: RandomController(SEED), TABLE1_OBSTACLES, "random"),
-    "ablation-no-svs": (CHECKPOINTS / "no-svs.pt", (ABLATION_OBSTACLES,), "no SVS map"),
-    "ablation-no-gru": (CHECKPOINTS / "no-gru.pt", (ABLATION_OBSTACLES,), "no GRU"),
+Source = Callable[[], Controller] | Path
+#: Evaluation file -> (baseline factory or checkpoint file, obstacle counts, policy label,
+#: object shape).
+EVALUATIONS: dict[str, tuple[Source, tuple[int, ...], str, TargetShape]] = {
+    "table1-learned": (shipped_policy_path(), TABLE1_OBSTACLES, "learned (shipped)", "cylinder"),
+    "table1-orbit": (OrbitController, TABLE1_OBSTACLES, "orbit", "cylinder"),
+    "table1-random": (lambda: RandomController(SEED), TABLE1_OBSTACLES, "random", "cylinder"),
+    "ablation-no-svs": (CHECKPOINTS / "no-svs.pt", (ABLATION_OBSTACLES,), "no SVS map", "cylinder"),
+    "ablation-no-gru": (CHECKPOINTS / "no-gru.pt", (ABLATION_OBSTACLES,), "no GRU", "cylinder"),
 }
+for _shape in OTHER_SHAPES:  # the generalisation table: one evaluation per shape
+    EVALUATIONS[f"shape-learned-{_shape}"] = (
+        shipped_policy_path(),
+        (ABLATION_OBSTACLES,),
+        "learned (shipped)",
+        _shape,
+    )
+    EVALUATIONS[f"shape-orbit-{_shape}"] = (OrbitController, (ABLATION_OBSTACLES,), "orbit", _shape)
 
 
 def log(text: str) -> None:
@@ -82,7 +96,7 @@ def log(text: str) -> None:
 
 def run_evaluation(name: str, episodes: int, data: Path) -> EvaluationResult:
     """Evaluate one controller and keep its JSON under ``data``."""
-    source, counts, label = EVALUATIONS[name]
+    source, counts, label, shape = EVALUATIONS[name]
     controller: Controller
     if isinstance(source, Path):
         controller, digest = load_controller(source), file_sha256(source)
@@ -93,7 +107,7 @@ def run_evaluation(name: str, episodes: int, data: Path) -> EvaluationResult:
         counts,
         episodes,
         SEED,
-        config=controller_evaluation_config(controller),
+        config=controller_evaluation_config(controller, (shape,)),
         num_envs=ENVS,
         policy=label,
         checkpoint_sha256=digest,

@@ -194,3 +194,27 @@ def test_a_version_1_file_is_refused_with_how_to_regenerate_it(runs, tmp_path):
 def test_bad_protocols_are_refused(counts, episodes, message):
     with pytest.raises(InvalidInputError, match=message):
         evaluate(RandomController(), counts, episodes, seed=0, config=SHORT)
+
+
+def test_a_policy_with_an_env_config_has_it_recorded_beside_the_evaluated_one(tmp_path):
+    class Trained(RandomController):
+        env_config = EnvConfig.legacy(episode_seconds=45.0)
+
+    result = evaluate(Trained(), [0], 1, seed=0, config=SHORT, num_envs=1)
+    assert result.policy_env_config == Trained.env_config
+    assert result.config == SHORT  # the rooms are the protocol's, not the training's
+    restored = EvaluationResult.from_json(result.to_json(tmp_path / "evaluation.json"))
+    assert restored.policy_env_config == Trained.env_config
+    assert evaluate(RandomController(), [0], 1, 0, config=SHORT).policy_env_config is None
+
+
+def test_strict_coverage_tells_a_good_inspection_from_a_distant_one_the_lenient_rule_cannot():
+    """An orbit at d_ref and one 1.2 m farther both see the whole side within 3 m (lenient),
+    but only the first sees it at the distance the inspection asks for (strict)."""
+    config = EnvConfig(episode_seconds=30.0)
+    good = evaluate(OrbitController(), [0], 4, seed=1, config=config, num_envs=4)
+    far = evaluate(OrbitController(distance=2.7), [0], 4, seed=1, config=config, num_envs=4)
+    assert good.at(0).rooms == far.at(0).rooms  # the same rooms
+    assert good.at(0).coverage_pct > 60.0 and far.at(0).coverage_pct > 60.0
+    assert good.at(0).strict_coverage_pct > 70.0
+    assert far.at(0).strict_coverage_pct < 0.5 * good.at(0).strict_coverage_pct

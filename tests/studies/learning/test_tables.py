@@ -110,8 +110,9 @@ def test_table1_names_its_controllers_by_their_policy_label(results, tmp_path) -
     rows = table1_evaluations(stored)
     assert list(rows) == ["learned (shipped)", "orbit", "random"]
     assert rows["orbit"] is stored["table1-orbit"]
-    sections = reproduction_sections(stored)
-    assert set(sections) == set(SECTIONS)
+    tables = {"rl-table1", "rl-table2", "rl-table3"}  # the shapes need their own evaluations
+    sections = reproduction_sections(stored, tables)
+    assert set(sections) == tables
     assert "| crash % | 004 | 1.0 | 1.2 |" in sections["rl-table2"]
     assert sections["rl-table3"].count("not trained") == 5  # no GRU 512 of ours
 
@@ -133,3 +134,27 @@ def test_published_tables_match_their_stored_evaluations() -> None:
     shipped = stored["table1-learned"]
     assert shipped.results[0].episodes == 100
     assert shipped.checkpoint_sha256 is not None
+
+
+def test_the_shapes_section_takes_each_policys_training_shapes_from_its_evaluation() -> None:
+    class Trained(RandomController):
+        env_config = EnvConfig.legacy()  # cylinders only, as policy v1
+
+    learned, orbit = Trained(0), OrbitController()
+    stored = {}
+    for stem, controller, label in (
+        ("learned", learned, "learned (shipped)"),
+        ("orbit", orbit, "orbit"),
+    ):
+        for shape in ("cylinder", "box", "sphere", "t-pipe"):
+            config = SHORT.model_copy(update={"target_shapes": (shape,)})
+            result = evaluate(controller, [9], 1, 0, config=config, num_envs=1, policy=label)
+            name = f"table1-{stem}" if shape == "cylinder" else f"shape-{stem}-{shape}"
+            stored[name] = result
+    text = reproduction_sections(stored, {"rl-shapes"})["rl-shapes"]
+    learned_rows = [line for line in text.splitlines() if "| learned (shipped) |" in line]
+    assert len(learned_rows) == 2  # strict coverage and crash
+    for row in learned_rows:
+        cells = row.split(" | ")[2:]
+        assert "(unseen)" not in cells[0] and all("(unseen)" in c for c in cells[1:])
+    assert "(unseen)" not in "".join(line for line in text.splitlines() if "| orbit |" in line)

@@ -52,11 +52,15 @@ class OrbitController:
     Args:
         gain: proportional gain from position error (m) to commanded speed (fraction of w_max).
         above_top: height of the second loop over the object's top (m).
+        distance: how far from the object's horizontal extent to circle (m); None: d_ref.
     """
 
-    def __init__(self, gain: float = 1.5, above_top: float = 0.6) -> None:
+    def __init__(
+        self, gain: float = 1.5, above_top: float = 0.6, distance: float | None = None
+    ) -> None:
         self.gain = gain
         self.above_top = above_top
+        self.distance = distance
         self._swept = np.zeros(0)
         self._last_angle = np.zeros(0)
 
@@ -77,7 +81,8 @@ class OrbitController:
         )
         self._swept += np.abs(step)
         self._last_angle = angle
-        radius = np.array([room.target_radius for room in rooms]) + cfg.d_ref
+        standoff = cfg.d_ref if self.distance is None else self.distance
+        radius = np.array([room.target_radius for room in rooms]) + standoff
         distance = np.linalg.norm(offset, axis=1)
         outward = offset / np.maximum(distance, 1e-6)[:, None]
         tangent = np.stack([-outward[:, 1], outward[:, 0]], axis=1)

@@ -133,6 +133,8 @@ class EvaluationResult(BaseModel):
     config: EnvConfig
     #: SHA-256 of the checkpoint file flown; None for a baseline.
     checkpoint_sha256: str | None
+    #: The env config the flown policy was trained in (its checkpoint's); None for a baseline.
+    policy_env_config: EnvConfig | None = None
     wall_seconds: float
     results: list[ObstacleResult]
 
@@ -284,6 +286,7 @@ def evaluate(
         num_envs=num_envs,
         config=base,
         checkpoint_sha256=checkpoint_sha256,
+        policy_env_config=getattr(controller, "env_config", None),
         wall_seconds=time.perf_counter() - started,
         results=results,
     )

@@ -14,7 +14,7 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import NamedTuple
 
-from seminspect.missions.learning.env_config import TARGET_SHAPES
+from seminspect.missions.learning.env_config import TARGET_SHAPES, TargetShape
 from seminspect.missions.learning.evaluation import (
     PAPER_TABLE1,
     PAPER_TABLE2,
@@ -25,11 +25,17 @@ from seminspect.missions.learning.evaluation import (
 )
 
 #: The sections of docs/reproduction.md, and the stored evaluations (file stems) each needs.
-SECTIONS = ("rl-table1", "rl-table2", "rl-table3")
+SECTIONS = ("rl-table1", "rl-table2", "rl-table3", "rl-shapes")
+#: The shapes beside Table I's cylinders in the generalisation table, and their evaluations.
+OTHER_SHAPES: tuple[TargetShape, ...] = ("box", "sphere", "t-pipe")
+SHAPE_EVALUATIONS = tuple(
+    f"shape-{controller}-{shape}" for controller in ("learned", "orbit") for shape in OTHER_SHAPES
+)
 NEEDS = {
     "rl-table1": ("table1-learned", "table1-orbit", "table1-random"),
     "rl-table2": ("table1-learned", "ablation-no-svs"),
     "rl-table3": ("table1-learned", "ablation-no-gru"),
+    "rl-shapes": ("table1-learned", "table1-orbit", *SHAPE_EVALUATIONS),
 }
 #: 004 Tables II and III are measured in rooms with nine obstacles.
 ABLATION_OBSTACLES = 9
@@ -183,4 +189,23 @@ def reproduction_sections(
         no_gru = results["ablation-no-gru"].at(ABLATION_OBSTACLES)
         ours = {"no GRU": no_gru, "GRU 128": shipped, "GRU 512": None}
         sections["rl-table3"] = ablation_markdown(PAPER_TABLE3, ours)
+    if "rl-shapes" in wanted:
+        sections["rl-shapes"] = _shapes_section(results)
     return sections
+
+
+def _shapes_section(results: Mapping[str, EvaluationResult]) -> str:
+    """The generalisation table from Table I's cylinders and the other shapes' evaluations.
+
+    A learned policy's training shapes come from the env config its evaluation recorded; a
+    baseline has no training, so no shape is unseen for it.
+    """
+    by_policy: dict[str, dict[str, EvaluationResult]] = {}
+    trained: dict[str, Sequence[str]] = {}
+    for name in NEEDS["rl-shapes"]:
+        result = results[name]
+        (shape,) = result.config.target_shapes
+        by_policy.setdefault(result.policy, {})[shape] = result
+        own = result.policy_env_config
+        trained[result.policy] = TARGET_SHAPES if own is None else own.target_shapes
+    return generalisation_markdown(by_policy, trained)
