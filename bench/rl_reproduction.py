@@ -13,7 +13,9 @@ document still matches them.
 * ``rl-table2``: the policy trained without the SVS map beside the shipped one, 9 obstacles;
 * ``rl-table3``: the policy trained without a GRU beside the shipped one (GRU 128), 9 obstacles;
 * ``rl-shapes``: the shipped policy and the orbit on the four object shapes, 9 obstacles (a
-  shape the policy's training rooms never held is marked unseen).
+  shape the policy's training rooms never held is marked unseen);
+* ``rl-v2``: policy v2 (the paper's rooms, reward and maps; still training, not shipped) and
+  its two ablations beside the shipped policy and the orbit, 9 obstacles.
 
 With Table I it also draws ``docs/images/rl-coverage.png``: coverage against time of the three
 controllers at each obstacle count (mean and 5th-95th percentile, as 004 Fig 5), and
@@ -33,6 +35,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+from seminspect.core.errors import FileFormatError
 from seminspect.core.io import file_sha256
 from seminspect.missions.learning.agent import load_controller, shipped_policy_path
 from seminspect.missions.learning.baselines import Controller, OrbitController, RandomController
@@ -79,6 +82,26 @@ EVALUATIONS: dict[str, tuple[Source, tuple[int, ...], str, TargetShape]] = {
     "table1-random": (lambda: RandomController(SEED), TABLE1_OBSTACLES, "random", "cylinder"),
     "ablation-no-svs": (CHECKPOINTS / "no-svs.pt", (ABLATION_OBSTACLES,), "no SVS map", "cylinder"),
     "ablation-no-gru": (CHECKPOINTS / "no-gru.pt", (ABLATION_OBSTACLES,), "no GRU", "cylinder"),
+}
+EVALUATIONS |= {
+    "v2-main": (
+        CHECKPOINTS / "v2-main" / "checkpoint.pt",
+        (ABLATION_OBSTACLES,),
+        "v2 (5.0 M steps)",
+        "cylinder",
+    ),
+    "v2-no-svs": (
+        CHECKPOINTS / "v2-no-svs" / "checkpoint.pt",
+        (ABLATION_OBSTACLES,),
+        "v2, no SVS map (2.0 M steps)",
+        "cylinder",
+    ),
+    "v2-no-gru": (
+        CHECKPOINTS / "v2-no-gru" / "checkpoint.pt",
+        (ABLATION_OBSTACLES,),
+        "v2, no GRU (2.0 M steps)",
+        "cylinder",
+    ),
 }
 for _shape in OTHER_SHAPES:  # the generalisation table: one evaluation per shape
     EVALUATIONS[f"shape-learned-{_shape}"] = (
@@ -157,7 +180,10 @@ def main() -> None:
     names = [] if args.tables_only else args.evaluation
     sections = regenerate(wanted, args.episodes, names)
     if sections:
-        rewrite_sections(args.doc, sections)
+        try:
+            rewrite_sections(args.doc, sections)
+        except FileFormatError as error:
+            raise SystemExit(f"error: {error}") from None
         log(f"rewrote {', '.join(sorted(sections))} in {args.doc}; policy: {shipped_policy_path()}")
 
 

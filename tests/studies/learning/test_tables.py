@@ -17,6 +17,7 @@ from seminspect.studies.learning.tables import (
     ablation_markdown,
     generalisation_markdown,
     load_evaluations,
+    policies_markdown,
     reproduction_sections,
     table1_evaluations,
     table1_markdown,
@@ -90,6 +91,24 @@ def test_generalisation_marks_the_shapes_a_policy_never_trained_on(results) -> N
     assert lines[3] == f"| strict coverage % | boxes | - | {on_box} |"
     assert sum(line.startswith("| crash % |") for line in lines) == 2
     assert text.count("(unseen)") == 2  # the box column of the cylinder policy, per measure
+    assert text.endswith("9 obstacles; episodes per cell: 2.")
+
+
+def test_policies_side_by_side_give_every_measure_at_one_obstacle_count(results) -> None:
+    text = policies_markdown({"orbit": results["orbit"], "random": results["random"]}, 9)
+    lines = text.splitlines()
+    assert lines[0] == (
+        "| policy | coverage % (lenient) | strict coverage % | distance score | crash % "
+        "| timeout % |"
+    )
+    assert lines[2] == "| 004 (Aerial Gym, GPU) | 74.6 | 74.6 | - | 1.2 | 98.8 |"
+    row = results["random"].at(9)
+    assert lines[4] == (
+        f"| random | {row.coverage_pct:.1f} | "
+        f"{_interval(row.strict_coverage_pct, row.strict_coverage_ci)} | "
+        f"{row.distance_score:.2f} | {_interval(row.crash_pct, row.crash_ci)} | "
+        f"{row.timeout_pct:.1f} |"
+    )
     assert text.endswith("9 obstacles; episodes per cell: 2.")
 
 

@@ -5,7 +5,8 @@ compares numbers in the same column: coverage lenient (within ``inspect_range``)
 the feasible faces, with its 95 % interval), the distance score, crash % (with its Wilson 95 %
 interval) and timeout %. The paper reports one coverage; it stands beside both of ours.
 Percentages have one decimal, as in the paper. :func:`generalisation_markdown` shows policies
-on object shapes, marking those they never met in training.
+on object shapes, marking those they never met in training; :func:`policies_markdown` sets
+whole policies (the shipped one, the next one in training, its ablations) side by side.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from seminspect.missions.learning.evaluation import (
 )
 
 #: The sections of docs/reproduction.md, and the stored evaluations (file stems) each needs.
-SECTIONS = ("rl-table1", "rl-table2", "rl-table3", "rl-shapes")
+SECTIONS = ("rl-table1", "rl-table2", "rl-table3", "rl-shapes", "rl-v2")
 #: The shapes beside Table I's cylinders in the generalisation table, and their evaluations.
 OTHER_SHAPES: tuple[TargetShape, ...] = ("box", "sphere", "t-pipe")
 SHAPE_EVALUATIONS = tuple(
@@ -36,6 +37,7 @@ NEEDS = {
     "rl-table2": ("table1-learned", "ablation-no-svs"),
     "rl-table3": ("table1-learned", "ablation-no-gru"),
     "rl-shapes": ("table1-learned", "table1-orbit", *SHAPE_EVALUATIONS),
+    "rl-v2": ("table1-learned", "v2-main", "v2-no-svs", "v2-no-gru", "table1-orbit"),
 }
 #: 004 Tables II and III are measured in rooms with nine obstacles.
 ABLATION_OBSTACLES = 9
@@ -161,6 +163,30 @@ def generalisation_markdown(
     return "\n".join(lines)
 
 
+def policies_markdown(
+    results: Mapping[str, EvaluationResult], obstacles: int = ABLATION_OBSTACLES
+) -> str:
+    """Every measure (columns) of each policy (rows) at one obstacle count, 004's row first.
+
+    ``results`` maps a row label to its evaluation; each must hold ``obstacles``.
+    """
+    lines = [
+        "| policy | " + " | ".join(m.label for m in MEASURES) + " |",
+        "|---|" + "---:|" * len(MEASURES),
+    ]
+    paper = PAPER_TABLE1.get(obstacles)
+    lines.append(f"| 004 (Aerial Gym, GPU) | {_cells([_paper(paper, m) for m in MEASURES])} |")
+    for name, result in results.items():
+        row = result.at(obstacles)
+        lines.append(f"| {name} | {_cells([m.cell(row) for m in MEASURES])} |")
+    episodes = sorted({r.at(obstacles).episodes for r in results.values()})
+    lines.append("")
+    lines.append(
+        f"{obstacles} obstacles; episodes per cell: {', '.join(str(n) for n in episodes)}."
+    )
+    return "\n".join(lines)
+
+
 def load_evaluations(directory: Path) -> dict[str, EvaluationResult]:
     """Every stored evaluation of a directory, by file stem."""
     return {p.stem: EvaluationResult.from_json(p) for p in sorted(directory.glob("*.json"))}
@@ -191,6 +217,9 @@ def reproduction_sections(
         sections["rl-table3"] = ablation_markdown(PAPER_TABLE3, ours)
     if "rl-shapes" in wanted:
         sections["rl-shapes"] = _shapes_section(results)
+    if "rl-v2" in wanted:
+        rows = {results[n].policy: results[n] for n in NEEDS["rl-v2"]}
+        sections["rl-v2"] = policies_markdown(rows)
     return sections
 
 
