@@ -14,7 +14,7 @@ document still matches them.
 * ``rl-table3``: the policy trained without a GRU beside the shipped one (GRU 128), 9 obstacles;
 * ``rl-shapes``: the shipped policy and the orbit on the four object shapes, 9 obstacles (a
   shape the policy's training rooms never held is marked unseen);
-* ``rl-v2``: policy v2 (the paper's rooms, reward and maps; still training, not shipped) and
+* ``rl-v2``: policy v2 (the paper's rooms, reward and maps; trained, not shipped) and
   its two ablations beside the shipped policy and the orbit, 9 obstacles.
 
 With Table I it also draws ``docs/images/rl-coverage.png``: coverage against time of the three
@@ -83,25 +83,15 @@ EVALUATIONS: dict[str, tuple[Source, tuple[int, ...], str, TargetShape]] = {
     "ablation-no-svs": (CHECKPOINTS / "no-svs.pt", (ABLATION_OBSTACLES,), "no SVS map", "cylinder"),
     "ablation-no-gru": (CHECKPOINTS / "no-gru.pt", (ABLATION_OBSTACLES,), "no GRU", "cylinder"),
 }
+#: Policy v2's runs (directories under CHECKPOINTS), by the label of their rows.
+V2_RUNS = {
+    "v2-main": "v2 (5.0 M steps)",
+    "v2-no-svs": "v2, no SVS map (2.0 M steps)",
+    "v2-no-gru": "v2, no GRU (2.0 M steps)",
+}
 EVALUATIONS |= {
-    "v2-main": (
-        CHECKPOINTS / "v2-main" / "checkpoint.pt",
-        (ABLATION_OBSTACLES,),
-        "v2 (5.0 M steps)",
-        "cylinder",
-    ),
-    "v2-no-svs": (
-        CHECKPOINTS / "v2-no-svs" / "checkpoint.pt",
-        (ABLATION_OBSTACLES,),
-        "v2, no SVS map (2.0 M steps)",
-        "cylinder",
-    ),
-    "v2-no-gru": (
-        CHECKPOINTS / "v2-no-gru" / "checkpoint.pt",
-        (ABLATION_OBSTACLES,),
-        "v2, no GRU (2.0 M steps)",
-        "cylinder",
-    ),
+    run: (CHECKPOINTS / run / "checkpoint.pt", (ABLATION_OBSTACLES,), label, "cylinder")
+    for run, label in V2_RUNS.items()
 }
 for _shape in OTHER_SHAPES:  # the generalisation table: one evaluation per shape
     EVALUATIONS[f"shape-learned-{_shape}"] = (
