@@ -86,6 +86,7 @@ EVALUATIONS: dict[str, tuple[Source, tuple[int, ...], str, TargetShape]] = {
 #: Policy v2's runs (directories under CHECKPOINTS), by the label of their rows.
 V2_RUNS = {
     "v2-main": "v2 (5.0 M steps)",
+    "v2-main-2m": "v2 (2.0 M steps)",
     "v2-no-svs": "v2, no SVS map (2.0 M steps)",
     "v2-no-gru": "v2, no GRU (2.0 M steps)",
 }

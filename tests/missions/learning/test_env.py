@@ -320,3 +320,25 @@ def test_the_fraction_reward_is_the_distance_weighted_fraction_seen_so_far(monke
     np.testing.assert_allclose(paid, levels, rtol=1e-12)
     assert paid == sorted(paid)  # what was inspected stays inspected
     assert 0.2 < paid[-1] <= 1.0  # the orbit sees a good part of the target
+
+
+def test_the_shaped_reward_is_the_streams_increment_and_a_crash_forfeits_it():
+    discount, rooms = 0.99, 8
+    shaped_config = EnvConfig(obstacles=9, shaping_discount=discount)
+    plain = InspectionVectorEnv(rooms, EnvConfig(obstacles=9), seed=4, autoreset=False)
+    shaped = InspectionVectorEnv(rooms, shaped_config, seed=4, autoreset=False)
+    plain.reset(seed=4)
+    shaped.reset(seed=4)
+    before = shaped.distance_scores().mean(axis=1)  # f_0, the reset's view
+    actions = np.random.default_rng(4).uniform(-1.0, 1.0, (120, rooms, 4)).astype(np.float32)
+    crashes = 0
+    for action in actions:
+        live = ~shaped._done
+        _, plain_reward, _, _, _ = plain.step(action)
+        _, shaped_reward, crash, _, _ = shaped.step(action)
+        f_t = shaped.distance_scores().mean(axis=1)
+        expected = plain_reward + np.where(live, (f_t - before) / (1 - discount) - f_t, 0.0)
+        expected -= np.where(crash, discount * f_t / (1 - discount), 0.0)
+        np.testing.assert_allclose(shaped_reward, expected, rtol=1e-5, atol=1e-4)
+        before, crashes = f_t, crashes + int(crash.sum())
+    assert crashes > 0  # the crash term was exercised

@@ -16,6 +16,8 @@ def test_the_default_episode_is_004s_90_seconds_at_10_hz():
         ({"map_cells": 20}, "odd"),
         ({"image_size": (0, 54)}, "positive"),
         ({"robot_radius": 0.5, "d_coll": 0.3}, "must not exceed d_coll"),
+        ({"face_reward": "repaid", "shaping_discount": 0.99}, "fraction reward only"),
+        ({"shaping_discount": 1.0}, "less than 1"),
     ],
 )
 def test_inconsistent_settings_are_refused(changes, message):

@@ -13,6 +13,7 @@ import pytest
 import torch
 
 from fake_vector_env import TargetReachEnv
+from seminspect.core.errors import InvalidInputError
 from seminspect.core.interrupts import Interrupted
 from seminspect.missions.learning.checkpoints import read_checkpoint
 from seminspect.missions.learning.env_config import EnvConfig
@@ -52,6 +53,14 @@ def run(tmp_path: Path, updates: int, **changes: object) -> tuple[list[ProgressR
 
     train(make_env, PolicyConfig.small(), config, tmp_path, env_config=ROOMS, progress=rows.append)
     return rows, envs
+
+
+def test_a_reward_shaped_for_another_discount_is_refused_before_training(tmp_path: Path) -> None:
+    config = TrainConfig.model_validate(QUICK | {"total_steps": 128})
+    shaped = EnvConfig(shaping_discount=0.99)  # PPO discounts by QUICK's 0.9
+    with pytest.raises(InvalidInputError, match=r"discount 0\.99 but PPO discounts by 0\.9"):
+        train(TargetReachEnv, PolicyConfig.small(), config, tmp_path, env_config=shaped)
+    assert not any(tmp_path.iterdir())  # nothing written
 
 
 def test_training_raises_the_return(tmp_path: Path) -> None:

@@ -1,5 +1,5 @@
-"""The reward terms of 004 eq (6) by hand: f_t's face scores (repaid and fraction), v_t and
-p_t (binary and graded)."""
+"""The reward terms of 004 eq (6) by hand: f_t's face scores (repaid and fraction), its
+shaping, v_t and p_t (binary and graded)."""
 
 import math
 
@@ -13,6 +13,8 @@ from seminspect.missions.learning.rewards import (
     graded_penalty,
     inspected_fraction,
     semantic_search_reward,
+    shaped_fraction,
+    shaping_forfeit,
     updated_best,
 )
 
@@ -98,3 +100,31 @@ def test_the_fraction_form_pays_the_distance_weighted_fraction_so_far_at_every_s
     assert float(inspected_fraction(again, D_REF, BETA)[0]) == paid[-1]
     every_face_at_d_ref = np.full((2, 60), D_REF)
     np.testing.assert_array_equal(inspected_fraction(every_face_at_d_ref, D_REF, BETA), [1.0, 1.0])
+
+
+def _shaped_stream(stream: np.ndarray, discount: float, crashed: bool) -> np.ndarray:
+    """The shaped pay of steps 1..T of a fraction stream f_0..f_T (f_0: the reset's view)."""
+    paid = shaped_fraction(stream[1:], stream[:-1], discount)
+    if crashed:
+        paid[-1] -= shaping_forfeit(stream[-1:], discount)[0]
+    return paid
+
+
+@pytest.mark.parametrize("crashed", [True, False])
+def test_shaping_keeps_the_streams_discounted_return_up_to_the_start_potential(crashed):
+    # Ng et al.'s identity: sum_k g^(k-1) r'_k = sum_k g^(k-1) f_k + g^T Phi_T - Phi_0, with
+    # Phi_T = 0 after a crash; after a timeout the shaped value V - Phi bootstraps the rest
+    discount = 0.99
+    stream = np.minimum(np.cumsum(np.random.default_rng(3).uniform(0.0, 0.04, 60)), 1.0)
+    weights = discount ** np.arange(len(stream) - 1)
+    streamed = weights @ stream[1:]
+    end = 0.0 if crashed else discount ** (len(stream) - 1) * stream[-1] / (1 - discount)
+    shaped = weights @ _shaped_stream(stream, discount, crashed) - end
+    assert shaped == pytest.approx(streamed - stream[0] / (1 - discount), rel=1e-12)
+
+
+def test_shaping_pays_a_face_when_it_is_seen_and_nothing_while_the_fraction_holds():
+    paid = shaped_fraction(np.array([0.3, 0.3]), np.array([0.2, 0.3]), 0.99)
+    np.testing.assert_allclose(paid, [10.0, 0.0])
+    # a crash at f = 0.5 forfeits what the stream would still have paid, g f / (1 - g)
+    assert shaping_forfeit(np.array([0.5]), 0.99)[0] == pytest.approx(49.5)

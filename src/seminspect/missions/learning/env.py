@@ -19,11 +19,12 @@ Per step (10 Hz, the paper's image rate):
   occupied and outside the map 1, else 0) and the spatial visit score map m^h (eq (3)), both
   21^3 at 0.1 m in the yaw-aligned body frame.
 - Reward eq (6): face-mesh reward f_t (eqs (7)-(9), faces in the focus area only; the fraction
-  of faces inspected, weighted by distance, or v1's repaid scores), semantic-search reward v_t
-  (eq (10)) and the collision penalty p_t (-1 with an occupied m^o cell within d_coll; graded:
-  rising linearly to 0 at ``penalty_reach``). Contact (true clearance below the robot radius)
-  is a crash, ends the episode and costs ``crash_penalty``; reaching the episode length
-  without one is a timeout (Sec IV-A). Coverage: lenient and strict (a measure only).
+  of faces inspected, weighted by distance, paid as is or shaped, or v1's repaid scores),
+  semantic-search reward v_t (eq (10)) and the collision penalty p_t (-1 with an occupied m^o
+  cell within d_coll; graded: rising linearly to 0 at ``penalty_reach``). Contact (true
+  clearance below the robot radius) is a crash, ends the episode and costs ``crash_penalty``
+  (and a shaped reward's potential); reaching the episode length without one is a timeout
+  (Sec IV-A). Coverage: lenient and strict (a measure only).
 
 The parts have modules of their own: :mod:`.env_config` (the settings), :mod:`.sensors`,
 :mod:`.maps`, :mod:`.rewards`, :mod:`.face_views` and :mod:`.dynamics` (with the state
@@ -263,7 +264,8 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
             self._steps[live] += 1
             reward[live] = self._sense(live)
             crash[live] = self._crashed(live)
-        reward[crash] -= self.config.crash_penalty
+        crashed = np.flatnonzero(crash)
+        reward[crashed] -= self.config.crash_penalty + self._faces.crash_forfeit(crashed)
         timeout = ~crash & (self._steps >= self.config.steps_per_episode)
         timeout &= ~self._done
         self._return += reward

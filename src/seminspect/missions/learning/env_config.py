@@ -77,6 +77,15 @@ class EnvConfig(BaseModel):
         "inspected so far, paid every step (Sec III-C); repaid (v1): alpha exp(...) at "
         "every gain toward d_ref (eq (7))",
     )
+    shaping_discount: float | None = Field(
+        None,
+        gt=0.0,
+        lt=1.0,
+        description="with the fraction reward: pay f_t by potential-based shaping with "
+        "Phi = f_t / (1 - this) (Ng, Harada and Russell 1999): (f_t - f_{t-1}) / (1 - this) a "
+        "step, and a crash forfeits the stream. The trainer's discount, so that the best "
+        "policy is the stream's, credited when a face is seen; None: f_t paid as is",
+    )
     proximity_penalty: Literal["graded", "binary"] = Field(
         "graded",
         description="binary (eq (6)): -1 with an occupied m^o cell within d_coll; graded: "
@@ -114,6 +123,8 @@ class EnvConfig(BaseModel):
             raise ValueError("room_size_range needs 0 < low <= high on every axis")
         if len(set(self.target_shapes)) != len(self.target_shapes):
             raise ValueError(f"target_shapes repeats a shape: {self.target_shapes}")
+        if self.shaping_discount is not None and self.face_reward != "fraction":
+            raise ValueError("shaping_discount shapes the fraction reward only")
         return self
 
     @classmethod

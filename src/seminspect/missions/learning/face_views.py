@@ -19,6 +19,8 @@ from seminspect.missions.learning.rewards import (
     distance_score,
     face_scores,
     inspected_fraction,
+    shaped_fraction,
+    shaping_forfeit,
     updated_best,
 )
 from seminspect.missions.learning.rooms import TARGET_FACES
@@ -76,19 +78,23 @@ def strict_views(
 
 
 class FaceRecord:
-    """Per room and target face: d_f (inf: never seen in the focus area) and strictly seen."""
+    """Per room and target face: d_f (inf: never seen in the focus area) and strictly seen;
+    per room the last f_t (the potential of a shaped reward)."""
 
     def __init__(self, rooms: int, config: EnvConfig) -> None:
         self.config = config
         self.best = np.full((rooms, TARGET_FACES), np.inf)
         self.strict = np.zeros((rooms, TARGET_FACES), dtype=bool)
+        self.fraction = np.zeros(rooms)
 
     def clear(self, envs: NDArray[np.int64]) -> None:
         self.best[envs] = np.inf
         self.strict[envs] = False
+        self.fraction[envs] = 0.0
 
     def update(self, envs: NDArray[np.int64], views: FaceViews) -> NDArray[np.float64]:
-        """Take in one step's views of the rooms ``envs``; returns their f_t (eq (9))."""
+        """Take in one step's views of the rooms ``envs``; returns their f_t (eq (9)) as paid
+        (shaped with :attr:`EnvConfig.shaping_discount`)."""
         cfg = self.config
         mean, best = views.distance.reshape(len(envs), -1), self.best[envs]
         if cfg.face_reward == "repaid":
@@ -97,9 +103,20 @@ class FaceRecord:
         else:
             self.best[envs] = updated_best(mean, best, cfg.d_ref)
             f_t = inspected_fraction(self.best[envs], cfg.d_ref, cfg.beta)
+            if cfg.shaping_discount is not None:
+                previous, self.fraction[envs] = self.fraction[envs], f_t
+                f_t = shaped_fraction(f_t, previous, cfg.shaping_discount)
         rule = cfg.strict_band, cfg.strict_incidence_deg, cfg.strict_min_pixels
         self.strict[envs] |= strict_views(views, cfg.d_ref, *rule).reshape(len(envs), -1)
         return f_t
+
+    def crash_forfeit(self, envs: NDArray[np.int64]) -> NDArray[np.float64]:
+        """What a crash of the rooms ``envs`` costs beyond their step's pay: the shaped stream's
+        potential (:func:`.rewards.shaping_forfeit`); nothing for an unshaped reward."""
+        discount = self.config.shaping_discount
+        if discount is None:
+            return np.zeros(len(envs))
+        return shaping_forfeit(self.fraction[envs], discount)
 
     def distance_scores(self) -> NDArray[np.float64]:
         """s(d_f) per room and face: the best distance score of any focus-area view."""

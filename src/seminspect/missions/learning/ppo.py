@@ -45,6 +45,7 @@ import numpy as np
 import torch
 from torch import Tensor
 
+from seminspect.core.errors import InvalidInputError
 from seminspect.core.interrupts import deferred_signals, stop_on_signals
 from seminspect.core.rng import make_rng
 from seminspect.missions.learning.checkpoints import CHECKPOINT_NAME, save_checkpoint
@@ -312,6 +313,12 @@ def train(
     and on Ctrl-C or SIGTERM before the interruption propagates. The same seed gives the same
     run.
     """
+    shaping = env_config.shaping_discount
+    if shaping is not None and shaping != train_config.gamma:
+        raise InvalidInputError(
+            f"the env shapes its reward for discount {shaping} but PPO discounts by "
+            f"{train_config.gamma}: shaping leaves the best policy unchanged only with one"
+        )
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     with _torch_threads(train_config.threads):

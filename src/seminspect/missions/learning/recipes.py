@@ -3,7 +3,8 @@
 One place names every run, so the CLI, the reproduction script and the docs agree on what is
 trained: the network (:class:`PolicyConfig` preset plus the ablated part), the training rooms,
 the budgets and the PPO settings with the obstacle curriculum. (Policy v1, shipped, was trained
-before these rooms, in ``EnvConfig.legacy(episode_seconds=45.0)``.)
+before these rooms, in ``EnvConfig.legacy(episode_seconds=45.0)``; policy v2 in these rooms with
+f_t paid unshaped. Each checkpoint records the env config it was trained in.)
 """
 
 from __future__ import annotations
@@ -32,6 +33,8 @@ TRAINING_SHAPES: tuple[TargetShape, ...] = ("cylinder", "box", "sphere")
 #: 004 Sec IV-A sets up an obstacle curriculum without giving its schedule; this one is ours:
 #: (fraction of training, obstacle count), ending at the paper's nine.
 CURRICULUM = ((0.0, 0), (0.2, 4), (0.45, 9))
+#: PPO's discount, and so the potential of the shaped face reward (EnvConfig.shaping_discount).
+DISCOUNT = 0.99
 
 
 def policy_config(size: Literal["small", "paper"] = "small", variant: str = "main") -> PolicyConfig:
@@ -46,12 +49,14 @@ def policy_config(size: Literal["small", "paper"] = "small", variant: str = "mai
 
 def training_env_config(policy: PolicyConfig) -> EnvConfig:
     """004 Sec III-E's training rooms: sizes drawn from PAPER_ROOM_RANGE, 90 s episodes, the
-    training shapes; the SVS map as the network has it (Table II's ablation has none)."""
+    training shapes; the SVS map as the network has it (Table II's ablation has none); f_t
+    shaped for the trainer's discount."""
     return EnvConfig(
         room_size_range=PAPER_ROOM_RANGE,
         episode_seconds=90.0,
         target_shapes=TRAINING_SHAPES,
         use_svs=policy.use_svs,
+        shaping_discount=DISCOUNT,
     )
 
 
@@ -62,6 +67,7 @@ def train_config(steps: int, seed: int = 0, num_envs: int = 64) -> TrainConfig:
         num_envs=num_envs,
         rollout_steps=32,
         epochs=3,
+        gamma=DISCOUNT,
         seed=seed,
         checkpoint_every=100_000,
         curriculum=CURRICULUM,

@@ -60,6 +60,24 @@ def inspected_fraction(best: NDArray[np.float64], d_ref: float, beta: float) -> 
     return distance_score(best, d_ref, beta).mean(axis=1)
 
 
+def shaped_fraction(
+    fraction: NDArray[np.float64], previous: NDArray[np.float64], discount: float
+) -> NDArray[np.float64]:
+    """The stream f_t paid through the potential Phi = f / (1 - discount): the step's term
+    f_t + discount Phi_t - Phi_{t-1} = (f_t - f_{t-1}) / (1 - discount).
+
+    Potential-based shaping leaves the best policy under ``discount`` unchanged (Ng, Harada
+    and Russell 1999) and pays a face when it is seen, not spread over the rest of the episode.
+    """
+    return (fraction - previous) / (1.0 - discount)
+
+
+def shaping_forfeit(fraction: NDArray[np.float64], discount: float) -> NDArray[np.float64]:
+    """What a crash costs beyond its step's shaped term: a terminal state's potential is 0, so
+    the step pays f_t - Phi_{t-1}, which is :func:`shaped_fraction` less discount Phi_t."""
+    return discount * fraction / (1.0 - discount)
+
+
 def semantic_search_reward(visits: NDArray, gamma: float, delta: float) -> NDArray[np.float64]:
     """004 eq (10): v_t = gamma exp(-delta N_t)."""
     return gamma * np.exp(-delta * np.asarray(visits, dtype=np.float64))

@@ -34,7 +34,9 @@ from seminspect.missions.learning.train_config import TrainConfig
 #: The file name a training run saves its state under, beside ``checkpoint.pt``.
 TRAINING_STATE_NAME = "training-state.pt"
 STATE_FORMAT = "seminspect-rl-training-state"
-STATE_VERSION = 1
+#: 2: the pickled environment keeps each room's last f_t (the shaped reward's potential); a
+#: version 1 environment would resume without it.
+STATE_VERSION = 2
 _KIND = "training state"
 
 

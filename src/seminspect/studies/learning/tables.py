@@ -37,7 +37,14 @@ NEEDS = {
     "rl-table2": ("table1-learned", "ablation-no-svs"),
     "rl-table3": ("table1-learned", "ablation-no-gru"),
     "rl-shapes": ("table1-learned", "table1-orbit", *SHAPE_EVALUATIONS),
-    "rl-v2": ("table1-learned", "v2-main", "v2-no-svs", "v2-no-gru", "table1-orbit"),
+    "rl-v2": (
+        "table1-learned",
+        "v2-main",
+        "v2-main-2m",
+        "v2-no-svs",
+        "v2-no-gru",
+        "table1-orbit",
+    ),
 }
 #: 004 Tables II and III are measured in rooms with nine obstacles.
 ABLATION_OBSTACLES = 9
