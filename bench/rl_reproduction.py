@@ -25,20 +25,31 @@ The ablation checkpoints lie in ``bench/checkpoints/rl/`` (trained by the comman
 docs/learning.md). The default detector here is the simulator's privileged segmentation (the
 paper's is also privileged: Aerial Gym's segmentation camera).
 
+Every finished batch of rooms is kept in ``bench/.rl-batches/`` (ignored by git), named by the
+evaluation, its checkpoint's SHA-256, a digest of the learning package's code, the versions of
+numpy and torch, the env config, the seed and the batch: a stopped run resumes where it stopped,
+and ``--obstacles`` shares one evaluation's counts among processes (each fills the store; a
+last run without it assembles the JSON from the store in seconds).
+
 Run: ``.venv/bin/python bench/rl_reproduction.py [--only rl-table1 ...] [--episodes N]``
 """
 
 from __future__ import annotations
 
 import argparse
+import hashlib
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
+
+import numpy as np
+import torch
 
 from seminspect.core.errors import FileFormatError
 from seminspect.core.io import file_sha256
 from seminspect.missions.learning.agent import load_controller, shipped_policy_path
 from seminspect.missions.learning.baselines import Controller, OrbitController, RandomController
+from seminspect.missions.learning.batches import BatchStore
 from seminspect.missions.learning.env_config import TargetShape
 from seminspect.missions.learning.evaluation import (
     EvaluationResult,
@@ -63,6 +74,8 @@ ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "docs" / "data" / "rl"
 CHECKPOINTS = ROOT / "bench" / "checkpoints" / "rl"
 DOC = ROOT / "docs" / "reproduction.md"
+BATCHES = ROOT / "bench" / ".rl-batches"
+LEARNING_CODE = ROOT / "src" / "seminspect" / "missions" / "learning"
 PICTURE = ROOT / "docs" / "images" / "rl-coverage.png"
 TRAINING_PICTURE = ROOT / "docs" / "images" / "rl-training.png"
 #: The training logs kept beside the evaluations (copies of each run's progress.csv).
@@ -108,40 +121,66 @@ def log(text: str) -> None:
     print(f"[{time.strftime('%H:%M:%S')}] {text}", flush=True)
 
 
-def run_evaluation(name: str, episodes: int, data: Path) -> EvaluationResult:
-    """Evaluate one controller and keep its JSON under ``data``."""
+def code_digest() -> str:
+    """SHA-256 of the learning package's source: a batch flown by other code is flown again."""
+    digest = hashlib.sha256()
+    for path in sorted(LEARNING_CODE.rglob("*.py")):
+        digest.update(path.relative_to(LEARNING_CODE).as_posix().encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def run_evaluation(
+    name: str, episodes: int, data: Path, only: Sequence[int] | None = None
+) -> EvaluationResult:
+    """Evaluate one controller (its batches kept in BATCHES) and keep its JSON under ``data``;
+    with ``only``, just those obstacle counts, into the store alone."""
     source, counts, label, shape = EVALUATIONS[name]
     controller: Controller
     if isinstance(source, Path):
         controller, digest = load_controller(source), file_sha256(source)
     else:
         controller, digest = source(), None
+    identity = {
+        "evaluation": name, "checkpoint_sha256": digest, "code": code_digest(),
+        "numpy": np.__version__, "torch": torch.__version__,
+    }  # fmt: skip
     result = evaluate(
         controller,
-        counts,
+        [k for k in counts if only is None or k in only],
         episodes,
         SEED,
         config=controller_evaluation_config(controller, (shape,)),
         num_envs=ENVS,
         policy=label,
         checkpoint_sha256=digest,
+        store=BatchStore(BATCHES / name, identity),
     )
-    result.to_json(data / f"{name}.json")
-    log(f"{name}: {result.wall_seconds:.0f} s")
+    if only is None:
+        result.to_json(data / f"{name}.json")
+    log(f"{name}: {result.wall_seconds:.0f} s of flying")
     return result
 
 
 def regenerate(
-    wanted: set[str], episodes: int = EPISODES, names: list[str] | None = None
+    wanted: set[str],
+    episodes: int = EPISODES,
+    names: list[str] | None = None,
+    only: Sequence[int] | None = None,
 ) -> dict[str, str]:
     """Run the evaluations the wanted sections need (or ``names``), then build the sections.
 
-    Returns no sections when an evaluation a section needs has never been run.
+    Returns no sections when an evaluation a section needs has never been run, or when
+    ``only`` some obstacle counts were flown (into the store).
     """
     DATA.mkdir(parents=True, exist_ok=True)
     for name in sorted({n for s in wanted for n in NEEDS[s]}) if names is None else names:
         log(f"evaluating {name} ({episodes} episodes per obstacle count)")
-        run_evaluation(name, episodes, DATA)
+        run_evaluation(name, episodes, DATA, only)
+    if only is not None:
+        log(f"kept the batches of {sorted(only)} obstacles in {BATCHES}; run again without "
+            "--obstacles to write the evaluations")  # fmt: skip
+        return {}
     results = load_evaluations(DATA)
     missing = sorted({n for s in wanted for n in NEEDS[s]} - set(results))
     if missing:
@@ -164,12 +203,18 @@ def main() -> None:
         choices=sorted(EVALUATIONS),
         help="run only these evaluations (repeatable; e.g. to spread them over processes)",
     )
+    parser.add_argument(
+        "--obstacles",
+        type=int,
+        nargs="+",
+        help="fly only these obstacle counts, into the batch store (one process's share)",
+    )
     parser.add_argument("--tables-only", action="store_true", help="rewrite from stored JSON")
     parser.add_argument("--doc", type=Path, default=DOC)
     args = parser.parse_args()
     wanted = set(args.only or SECTIONS)
     names = [] if args.tables_only else args.evaluation
-    sections = regenerate(wanted, args.episodes, names)
+    sections = regenerate(wanted, args.episodes, names, args.obstacles)
     if sections:
         try:
             rewrite_sections(args.doc, sections)

@@ -25,7 +25,7 @@ import hashlib
 import os
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -38,6 +38,7 @@ from seminspect.core.io import read_versioned_json, write_versioned_json
 from seminspect.core.rng import make_rng
 from seminspect.core.validation import build, describe_validation_error
 from seminspect.missions.learning.baselines import Controller
+from seminspect.missions.learning.batches import BatchStore, BatchTally
 from seminspect.missions.learning.env import InspectionVectorEnv
 from seminspect.missions.learning.env_config import EnvConfig, TargetShape
 from seminspect.missions.learning.feasibility import feasible_faces
@@ -135,6 +136,7 @@ class EvaluationResult(BaseModel):
     checkpoint_sha256: str | None
     #: The env config the flown policy was trained in (its checkpoint's); None for a baseline.
     policy_env_config: EnvConfig | None = None
+    #: Seconds spent flying the batches, summed (a resumed evaluation's stored ones too).
     wall_seconds: float
     results: list[ObstacleResult]
 
@@ -175,21 +177,6 @@ class EpisodeTrace:
     track: NDArray[np.float64]
     face_distances: NDArray[np.float64]
     crashed: bool
-
-
-@dataclass
-class _Tally:
-    """Per-episode outcomes of one obstacle count, filled batch by batch."""
-
-    coverage: list[float] = field(default_factory=list)
-    strict: list[float] = field(default_factory=list)
-    scores: list[float] = field(default_factory=list)
-    feasible: list[int] = field(default_factory=list)
-    crashed: list[bool] = field(default_factory=list)
-    timed_out: list[bool] = field(default_factory=list)
-    length: list[int] = field(default_factory=list)
-    rooms: list[str] = field(default_factory=list)
-    curves: list[NDArray[np.float64]] = field(default_factory=list)
 
 
 def evaluation_config(
@@ -236,6 +223,7 @@ def evaluate(
     threads: int = 1,
     traces: dict[int, EpisodeTrace] | None = None,
     checkpoint_sha256: str | None = None,
+    store: BatchStore | None = None,
 ) -> EvaluationResult:
     """Run ``episodes`` rooms per obstacle count with ``controller`` (004 Sec IV-A).
 
@@ -252,12 +240,14 @@ def evaluate(
         threads: ray-casting threads of the environment.
         traces: if given, receives the first episode of each K for pictures.
         checkpoint_sha256: of the checkpoint ``controller`` flies, kept in the result.
+        store: finished batches are kept there and taken from there instead of flown again
+            (a stopped evaluation resumes; the first batch of a count is flown whenever
+            ``traces`` wants its episode).
     """
     counts = _checked_protocol(obstacle_counts, episodes, num_envs)
     base = config or evaluation_config(EnvConfig())
     total = len(counts) * episodes * base.steps_per_episode
-    started = time.perf_counter()
-    results = []
+    results, seconds = [], 0.0
     for index, obstacles in enumerate(counts):
         cfg = build(EnvConfig, {**base.model_dump(), "obstacles": obstacles}, "environment")
 
@@ -278,8 +268,10 @@ def evaluate(
             threads=threads,
             traces=traces,
             advance=advance,
+            store=store,
         )
         results.append(_summarise(obstacles, tally, cfg))
+        seconds += tally.seconds
     return EvaluationResult(
         policy=policy,
         seed=seed,
@@ -287,7 +279,7 @@ def evaluate(
         config=base,
         checkpoint_sha256=checkpoint_sha256,
         policy_env_config=getattr(controller, "env_config", None),
-        wall_seconds=time.perf_counter() - started,
+        wall_seconds=seconds,
         results=results,
     )
 
@@ -318,24 +310,35 @@ def _run_count(
     threads: int,
     traces: dict[int, EpisodeTrace] | None,
     advance: Callable[[int], None],
-) -> _Tally:
+    store: BatchStore | None,
+) -> BatchTally:
     """The ``episodes`` rooms of one obstacle count, in batches of at most ``num_envs`` rooms.
 
     ``advance`` hears the room-steps done in this count; ``traces`` gets its first episode.
     """
-    tally, obstacles = _Tally(), config.obstacles
+    tally, obstacles, steps = BatchTally(), config.obstacles, config.steps_per_episode
     for batch, first in enumerate(range(0, episodes, num_envs)):
         size = min(num_envs, episodes - first)
         record = traces is not None and batch == 0
+        stored = None if record or store is None else store.load(config, seed, batch, size)
+        if stored is not None:
+            tally.extend(stored)
+            advance((first + size) * steps)
+            continue
+        started = time.perf_counter()
         env = InspectionVectorEnv(size, config, autoreset=False, record=record, threads=threads)
 
-        def advance_batch(step: int, before=first * config.steps_per_episode, size=size) -> None:
+        def advance_batch(step: int, before=first * steps, size=size) -> None:
             advance(before + step * size)
 
-        _run_batch(env, controller, batch_seed(seed, obstacles, batch), tally, advance_batch)
+        flown = _run_batch(env, controller, batch_seed(seed, obstacles, batch), advance_batch)
+        flown.seconds = time.perf_counter() - started
+        if store is not None:
+            store.save(config, seed, batch, flown)
+        tally.extend(flown)
         if record and traces is not None:
             traces[obstacles] = EpisodeTrace(
-                env.rooms[0], env.track(0), env.face_distances(0), tally.crashed[0]
+                env.rooms[0], env.track(0), env.face_distances(0), flown.crashed[0]
             )
     return tally
 
@@ -344,10 +347,9 @@ def _run_batch(
     env: InspectionVectorEnv,
     controller: Controller,
     reset_seed: int,
-    tally: _Tally,
     advance: Callable[[int], None],
-) -> None:
-    """One episode in every room of ``env``; outcomes appended to ``tally``.
+) -> BatchTally:
+    """One episode in every room of ``env``, and their outcomes.
 
     The rooms' feasible faces are drawn from ``reset_seed`` too.
     """
@@ -375,15 +377,17 @@ def _run_batch(
     scored = feasible | seen[-1]
     counts = scored.sum(axis=1)
     curves = np.array(seen).sum(axis=2).T  # strictly seen faces only accumulate
-    tally.coverage += (100.0 * env.coverage()).tolist()
-    tally.strict += _share(100.0 * curves[:, -1], counts, 100.0).tolist()
-    tally.scores += _share((env.distance_scores() * scored).sum(axis=1), counts, 1.0).tolist()
-    tally.feasible += counts.tolist()
-    tally.crashed += crashed.tolist()
-    tally.timed_out += timed_out.tolist()
-    tally.length += length.tolist()
-    tally.rooms += fingerprints
-    tally.curves += list(_share(100.0 * curves, counts[:, None], 100.0))
+    return BatchTally(
+        coverage=(100.0 * env.coverage()).tolist(),
+        strict=_share(100.0 * curves[:, -1], counts, 100.0).tolist(),
+        scores=_share((env.distance_scores() * scored).sum(axis=1), counts, 1.0).tolist(),
+        feasible=counts.tolist(),
+        crashed=crashed.tolist(),
+        timed_out=timed_out.tolist(),
+        length=length.tolist(),
+        rooms=fingerprints,
+        curves=list(_share(100.0 * curves, counts[:, None], 100.0)),
+    )
 
 
 def _share(total: NDArray, counts: NDArray, empty: float) -> NDArray[np.float64]:
@@ -417,7 +421,7 @@ def mean_interval_pct(values: Sequence[float]) -> tuple[float, float]:
     return max(0.0, float(low)), min(100.0, float(high))
 
 
-def _summarise(obstacles: int, tally: _Tally, config: EnvConfig) -> ObstacleResult:
+def _summarise(obstacles: int, tally: BatchTally, config: EnvConfig) -> ObstacleResult:
     curves = np.array(tally.curves)
     interval = max(1, round(CURVE_INTERVAL * config.control_hz)) / config.control_hz
     return ObstacleResult(
