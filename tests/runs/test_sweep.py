@@ -178,19 +178,23 @@ def test_an_earlier_sweeps_tables_are_removed(tmp_path) -> None:
 
 
 class _StoppedRay(_FakeRay):
-    """A Ray whose first wait is cut short by Ctrl-C; the tasks in flight are cancelled and
-    the first of them still ends within the grace."""
+    """A Ray whose first wait is cut short by Ctrl-C; the tasks ``ended`` had already ended,
+    and of the others the first still ends within the grace."""
 
-    def __init__(self) -> None:
+    def __init__(self, ended: frozenset[int] = frozenset()) -> None:
         super().__init__()
+        self.ended = ended
         self.cancelled: list[int] = []
         self.grace: float | None = None
 
     def wait(self, refs, num_returns, timeout=None):
-        if not self.cancelled:
+        if timeout is None:  # the sweep's own wait for the next row
             raise KeyboardInterrupt
+        if timeout == 0:  # what has ended by now
+            return [r for r in refs if r in self.ended], [r for r in refs if r not in self.ended]
         self.grace = timeout
-        return [min(refs)], [max(refs)]
+        done = sorted(self.ended | {min(set(refs) - self.ended)})
+        return done, [r for r in refs if r not in done]
 
     def cancel(self, ref: int) -> None:
         self.cancelled.append(ref)
@@ -203,6 +207,14 @@ def test_a_stopped_ray_sweep_cancels_its_tasks_and_keeps_those_that_ended() -> N
     assert sorted(ray.cancelled) == [0, 1] and ray.grace == CANCEL_GRACE_S
     assert [r.state for r in raised.value.rows] == ["completed", "interrupted", "interrupted"]
     assert raised.value.signum == signal.SIGINT
+
+
+def test_a_task_that_ended_before_the_stop_is_not_cancelled() -> None:
+    ray = _StoppedRay(ended=frozenset({1}))
+    with pytest.raises(SweepInterrupted) as raised:
+        _gather(ray, _tasks("abc", exclusive=False), PROGRAM, None, slots=2)
+    assert ray.cancelled == [0]  # cancelling 1 as its reply arrives can abort Ray's driver
+    assert [r.state for r in raised.value.rows] == ["completed", "completed", "interrupted"]
 
 
 def test_ray_init_does_not_keep_its_own_stop_handlers(monkeypatch) -> None:

@@ -282,10 +282,13 @@ def _cancel(
 ) -> None:
     """Cancel the tasks in flight (Ray raises KeyboardInterrupt in them, so each run records
     its stop) and keep the rows of those that finish within :data:`CANCEL_GRACE_S`."""
-    for ref in pending:
-        ray.cancel(ref)
     if not pending:
         return
+    # Only what is still running: cancelling a task whose reply is on its way can trip a
+    # check in Ray's core worker that aborts the driver (ray-project/ray#54846).
+    finished, _ = ray.wait(list(pending), num_returns=len(pending), timeout=0)
+    for ref in set(pending) - set(finished):
+        ray.cancel(ref)
     done, _ = ray.wait(list(pending), num_returns=len(pending), timeout=CANCEL_GRACE_S)
     for ref in done:
         row = _ray_row(ray, ref, tasks[pending[ref]])
