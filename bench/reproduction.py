@@ -19,8 +19,9 @@ Sections:
 * ``team``: two robots against one on the large city;
 * ``routine-single``, ``routine-pairs``, ``routine-acceptance``, ``routine-tours``: 002's
   scenarios (``bench/routine_acceptance.py``);
-* ``rl-table1``, ``rl-table2``, ``rl-table3``, ``rl-shapes``, ``rl-v2``: 004 Tables I-III, the
-  shapes table and policy v2 from ``bench/rl_reproduction.py``
+* ``rl-table1``, ``rl-table2``, ``rl-table3``, ``rl-shapes``, ``rl-retrained``: 004 Tables
+  I-III, the shapes table and the policies retrained in the paper's rooms from
+  ``bench/rl_reproduction.py``
   (the shipped policy, its ablations and the baselines, 100 episodes per obstacle count).
 
 Every mission runs as one ``seminspect`` sweep on a local Ray, one mission per core

@@ -14,8 +14,8 @@ document still matches them.
 * ``rl-table3``: the policy trained without a GRU beside the shipped one (GRU 128), 9 obstacles;
 * ``rl-shapes``: the shipped policy and the orbit on the four object shapes, 9 obstacles (a
   shape the policy's training rooms never held is marked unseen);
-* ``rl-v2``: policy v2 (the paper's rooms, reward and maps; trained, not shipped) and
-  its two ablations beside the shipped policy and the orbit, 9 obstacles.
+* ``rl-retrained``: the policies trained in the paper's rooms, reward and maps (v2: f_t paid
+  as is; v3: shaped), not shipped yet, beside the shipped policy and the orbit, 9 obstacles.
 
 With Table I it also draws ``docs/images/rl-coverage.png``: coverage against time of the three
 controllers at each obstacle count (mean and 5th-95th percentile, as 004 Fig 5), and
@@ -96,8 +96,8 @@ EVALUATIONS: dict[str, tuple[Source, tuple[int, ...], str, TargetShape]] = {
     "ablation-no-svs": (CHECKPOINTS / "no-svs.pt", (ABLATION_OBSTACLES,), "no SVS map", "cylinder"),
     "ablation-no-gru": (CHECKPOINTS / "no-gru.pt", (ABLATION_OBSTACLES,), "no GRU", "cylinder"),
 }
-#: Policy v2's runs (directories under CHECKPOINTS), by the label of their rows.
-V2_RUNS = {
+#: The runs in the paper's rooms (directories under CHECKPOINTS), by the label of their rows.
+RETRAINED_RUNS = {
     "v2-main": "v2 (5.0 M steps)",
     "v2-main-2m": "v2 (2.0 M steps)",
     "v2-no-svs": "v2, no SVS map (2.0 M steps)",
@@ -105,7 +105,7 @@ V2_RUNS = {
 }
 EVALUATIONS |= {
     run: (CHECKPOINTS / run / "checkpoint.pt", (ABLATION_OBSTACLES,), label, "cylinder")
-    for run, label in V2_RUNS.items()
+    for run, label in RETRAINED_RUNS.items()
 }
 for _shape in OTHER_SHAPES:  # the generalisation table: one evaluation per shape
     EVALUATIONS[f"shape-learned-{_shape}"] = (

@@ -26,7 +26,7 @@ from seminspect.missions.learning.evaluation import (
 )
 
 #: The sections of docs/reproduction.md, and the stored evaluations (file stems) each needs.
-SECTIONS = ("rl-table1", "rl-table2", "rl-table3", "rl-shapes", "rl-v2")
+SECTIONS = ("rl-table1", "rl-table2", "rl-table3", "rl-shapes", "rl-retrained")
 #: The shapes beside Table I's cylinders in the generalisation table, and their evaluations.
 OTHER_SHAPES: tuple[TargetShape, ...] = ("box", "sphere", "t-pipe")
 SHAPE_EVALUATIONS = tuple(
@@ -37,7 +37,7 @@ NEEDS = {
     "rl-table2": ("table1-learned", "ablation-no-svs"),
     "rl-table3": ("table1-learned", "ablation-no-gru"),
     "rl-shapes": ("table1-learned", "table1-orbit", *SHAPE_EVALUATIONS),
-    "rl-v2": (
+    "rl-retrained": (
         "table1-learned",
         "v2-main",
         "v2-main-2m",
@@ -224,9 +224,9 @@ def reproduction_sections(
         sections["rl-table3"] = ablation_markdown(PAPER_TABLE3, ours)
     if "rl-shapes" in wanted:
         sections["rl-shapes"] = _shapes_section(results)
-    if "rl-v2" in wanted:
-        rows = {results[n].policy: results[n] for n in NEEDS["rl-v2"]}
-        sections["rl-v2"] = policies_markdown(rows)
+    if "rl-retrained" in wanted:
+        rows = {results[n].policy: results[n] for n in NEEDS["rl-retrained"]}
+        sections["rl-retrained"] = policies_markdown(rows)
     return sections
 
 
