@@ -23,6 +23,7 @@ from pathlib import Path
 import torch
 
 from seminspect.core.io import atomic_write_text, dumps_json
+from seminspect.missions.learning.env_config import EnvConfig
 from seminspect.missions.learning.policy import (
     DEPTH_SHAPE,
     MAPS_SHAPE,
@@ -74,7 +75,7 @@ def measure(name: str, config: PolicyConfig, repeats: int) -> dict[str, float | 
 
     figures["minibatch_32x16_ms"] = median_ms(minibatch, max(1, repeats // 5))
     with tempfile.TemporaryDirectory() as folder:
-        path = save_checkpoint(Path(folder) / "checkpoint.pt", policy, None, steps=0)
+        path = save_checkpoint(Path(folder) / "checkpoint.pt", policy, None, 0, EnvConfig())
         figures["checkpoint_mb"] = path.stat().st_size / 1e6
     return figures
 
