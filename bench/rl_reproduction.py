@@ -45,7 +45,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from seminspect.core.errors import FileFormatError
+from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.core.io import file_sha256
 from seminspect.missions.learning.agent import load_controller, shipped_policy_path
 from seminspect.missions.learning.baselines import Controller, OrbitController, RandomController
@@ -214,12 +214,13 @@ def main() -> None:
     args = parser.parse_args()
     wanted = set(args.only or SECTIONS)
     names = [] if args.tables_only else args.evaluation
-    sections = regenerate(wanted, args.episodes, names, args.obstacles)
-    if sections:
-        try:
+    try:
+        sections = regenerate(wanted, args.episodes, names, args.obstacles)
+        if sections:
             rewrite_sections(args.doc, sections)
-        except FileFormatError as error:
-            raise SystemExit(f"error: {error}") from None
+    except (FileFormatError, InvalidInputError) as error:
+        raise SystemExit(f"error: {error}") from None
+    if sections:
         log(f"rewrote {', '.join(sorted(sections))} in {args.doc}; policy: {shipped_policy_path()}")
 
 
