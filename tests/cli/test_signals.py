@@ -8,6 +8,7 @@ so the file costs about as long as the commands take to get going.
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import os
 import re
@@ -146,9 +147,13 @@ class _Child:
         return _read(self.folder, "stdout") + _read(self.folder, "stderr")
 
 
-def _run_all(children: list[_Child], timeout: float = 240) -> None:
+def _run_all(children: list[_Child], timeout: float = 900, grace: float = 60) -> None:
     """Run the children a few at a time (they wait on imports as much as on a core), never two
-    of one command at once (two sweeps would share one machine's Ray)."""
+    of one command at once (two sweeps would share one machine's Ray).
+
+    ``timeout`` bounds the whole run generously: on a loaded two-core machine the twelve
+    children take minutes, and one cut off by the deadline mid-exit reads as a hang. A child
+    signalled before the deadline gets ``grace`` seconds more to end."""
     pending = sorted(children, key=lambda c: c.signum)
     running: list[_Child] = []
     deadline = time.monotonic() + timeout
@@ -160,6 +165,11 @@ def _run_all(children: list[_Child], timeout: float = 240) -> None:
             running.append(child)
         running = [child for child in running if not child.step()]
         time.sleep(0.1)
+    for child in running:
+        if child.signalled and child.process is not None:
+            # a real hang stays without an exit code, and the test says so
+            with contextlib.suppress(subprocess.TimeoutExpired):
+                child.process.wait(timeout=grace)
 
 
 @pytest.fixture(scope="module")
