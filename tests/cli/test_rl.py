@@ -11,22 +11,24 @@ from seminspect.missions.learning.evaluation import EvaluationResult, evaluation
 def test_eval_writes_the_json_the_pictures_the_report_and_a_table_beside_table_1(capsys, tmp_path):
     out = tmp_path / "eval"
     code, stdout, err = run(
-        capsys, "rl", "eval", "--policy", "orbit", "--obstacles", "0,4", "--episodes", "1",
+        capsys, "rl", "eval", "--policy", "orbit", "--obstacles", "0,14", "--episodes", "1",
         "--envs", "1", "--shapes", "box", "--out", str(out),
     )  # fmt: skip
     assert code == 0, err
     result = EvaluationResult.from_json(out / "evaluation.json")
-    assert [r.obstacles for r in result.results] == [0, 4]
+    assert [r.obstacles for r in result.results] == [0, 14]
     assert result.policy == "orbit" and result.at(0).episodes == 1
     assert result.checkpoint_sha256 is None  # a baseline
     assert result.config == evaluation_config(EnvConfig(), ("box",))  # the protocol's rooms
-    assert (out / "coverage.png").exists() and (out / "episode_04_3d.png").exists()
-    assert "92.1" in stdout and "82.6" in stdout and "0.3" in stdout  # 004 Table I beside ours
-    row = result.at(4)
+    assert (out / "coverage.png").exists() and (out / "episode_14_3d.png").exists()
+    assert "92.1" in stdout and "64.2" in stdout and "1.5" in stdout  # 004 Table I beside ours
+    row = result.at(14)
     assert f"{row.coverage_pct:.1f}" in stdout
     low, high = row.strict_coverage_ci
     assert f"{row.strict_coverage_pct:.1f} [{low:.1f}-{high:.1f}]" in stdout
     assert f"{row.crash_pct:.1f} [{row.crash_ci[0]:.1f}-{row.crash_ci[1]:.1f}]" in stdout
+    assert row.crashed == [True]  # the orbit meets an obstacle in this room
+    assert f"crashes at 14 obstacles struck: {row.struck[0]} 1" in stdout
     page = (out / "report.html").read_text(encoding="utf-8")
     assert "plotly" in page and "004 Table I" in page
     pictures = len(list(out.glob("*.png")))

@@ -207,6 +207,10 @@ def _print_table(result) -> None:
             "-" if paper is None else f"{paper[1]:.1f}",
         )
     console.print(table)
+    for row in result.results:
+        if struck := row.crashes_into():
+            named = ", ".join(f"{surface} {count}" for surface, count in struck.items())
+            console.print(f"crashes at {row.obstacles} obstacles struck: {named}")
 
 
 @app.command("show")

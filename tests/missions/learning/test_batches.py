@@ -4,6 +4,7 @@ by anything else is never reused, a damaged one is refused."""
 import pytest
 
 from seminspect.core.errors import FileFormatError
+from seminspect.missions.learning import batches as batches_module
 from seminspect.missions.learning.baselines import OrbitController, RandomController
 from seminspect.missions.learning.batches import BatchStore
 from seminspect.missions.learning.env import EnvConfig
@@ -73,3 +74,10 @@ def test_a_damaged_batch_is_refused_with_its_name(tmp_path):
     damaged.write_text(damaged.read_text()[:-40])
     with pytest.raises(FileFormatError, match=damaged.name):
         evaluate(OrbitController(), **PROTOCOL, store=store)
+
+
+def test_a_batch_of_another_layout_version_is_flown_again(tmp_path, monkeypatch):
+    store = BatchStore(tmp_path, {"evaluation": "orbit"})
+    now = store.path(SHORT, 1, 0, 2)
+    monkeypatch.setattr(batches_module, "BATCH_VERSION", batches_module.BATCH_VERSION - 1)
+    assert store.path(SHORT, 1, 0, 2) != now  # an older file is never read as this layout

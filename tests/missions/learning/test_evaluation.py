@@ -20,6 +20,7 @@ from seminspect.missions.learning.evaluation import (
     mean_interval_pct,
     wilson_pct,
 )
+from seminspect.missions.learning.rooms import SURFACES
 
 SHORT = EnvConfig(episode_seconds=3.0)
 
@@ -152,6 +153,22 @@ def test_the_result_round_trips_through_json(runs, tmp_path):
     path.write_text(path.read_text().replace('"episodes"', '"runs"', 1))
     with pytest.raises(FileFormatError, match="evaluation"):
         EvaluationResult.from_json(path)
+
+
+def test_every_crash_names_what_it_struck_and_older_files_load_without(runs, tmp_path):
+    rows = [row for result in runs[:2] for row in result.results]
+    crashes = sum(sum(row.crashed) for row in rows)
+    assert crashes > 0  # the random controller crashes in the cluttered rooms
+    for row in rows:
+        assert [bool(name) for name in row.struck] == row.crashed
+        assert set(row.struck) <= {"", *SURFACES}
+        assert sum(row.crashes_into().values()) == sum(row.crashed)
+    path = runs[1].to_json(tmp_path / "evaluation.json")
+    document = json.loads(path.read_text())
+    for row in document["results"]:
+        del row["struck"]  # as written before crashes were named
+    path.write_text(json.dumps(document))
+    assert all(row.crashes_into() == {} for row in EvaluationResult.from_json(path).results)
 
 
 def test_the_checkpoint_digest_is_kept_and_feasibility_is_decided_once_per_room(

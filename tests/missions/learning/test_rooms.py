@@ -12,12 +12,14 @@ from seminspect.missions.learning.rooms import (
     BOX,
     CYLINDER,
     SPHERE,
+    SURFACES,
     TARGET_FACES,
     Solids,
     clearance,
     sample_room,
     side_by_side,
     stack_solids,
+    struck_surface,
 )
 from seminspect.missions.learning.solids import solid_distance, surface_gap
 
@@ -227,3 +229,37 @@ def test_the_surface_rule_leaves_the_robots_width_and_comes_nearer_than_v1s():
     near = _nearest_gaps(_rooms("surface", 9, range(30)))
     legacy = _nearest_gaps(_rooms("target-sphere", 9, range(30)))
     assert np.median(near) < np.median(legacy) - 0.2
+
+
+def _solid(solids, i):
+    return Solids(solids.kind[i : i + 1], solids.centre[i : i + 1], solids.rotation[i : i + 1],
+                  solids.size[i : i + 1])  # fmt: skip
+
+
+def _apart(room, points, but=None, margin=0.3):
+    """The points at least ``margin`` from every solid other than ``but`` and from the walls."""
+    others = [j for j in range(len(room.solids.kind)) if j != but]
+    gaps = [solid_distance(points, _solid(room.solids, j)) for j in others]
+    walls = np.minimum(points, room.size - points).min(axis=1)
+    return points[np.minimum.reduce([walls, *gaps]) > margin]
+
+
+def test_a_crash_is_put_on_the_surface_it_struck():
+    rng = np.random.default_rng(0)
+    room = sample_room(np.random.default_rng(3), 9, EnvConfig(target_shapes=("t-pipe",)))
+    assert room.target_solids == 2  # the T-pipe's trunk and arm both count as the object
+    for i in range(len(room.solids.kind)):
+        near = _apart(room, _dense_surface(room.solids, i, rng, 2_000), but=i)
+        expected = "object" if i < room.target_solids else "obstacle"
+        assert len(near) > 0, f"solid {i} has no surface clear of the rest"
+        assert {struck_surface(room, p) for p in near[:25]} == {expected}
+    size = room.size
+    for name, fixed_axis, value in (
+        ("floor", 2, 0.05), ("ceiling", 2, size[2] - 0.05), ("wall", 0, 0.05),
+        ("wall", 1, size[1] - 0.05),
+    ):  # fmt: skip
+        points = rng.uniform((0.4, 0.4, 0.4), size - 0.4, (400, 3))
+        points[:, fixed_axis] = value
+        clear = [p for p in points if solid_distance(p[None], room.solids)[0] > 0.3]
+        assert clear and {struck_surface(room, p) for p in clear[:25]} == {name}
+    assert set(SURFACES) == {"wall", "floor", "ceiling", "object", "obstacle"}

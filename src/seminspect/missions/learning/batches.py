@@ -24,7 +24,7 @@ from seminspect.core.io import read_versioned_json, write_versioned_json
 from seminspect.missions.learning.env_config import EnvConfig
 
 BATCH_FORMAT = "seminspect.rl-evaluation-batch"
-BATCH_VERSION = 1
+BATCH_VERSION = 2  # 2: what each crash struck
 
 
 @dataclass
@@ -39,6 +39,7 @@ class BatchTally:
     crashed: list[bool] = field(default_factory=list)
     timed_out: list[bool] = field(default_factory=list)
     length: list[int] = field(default_factory=list)
+    struck: list[str] = field(default_factory=list)  # what each crash struck; "": none
     rooms: list[str] = field(default_factory=list)
     curves: list[NDArray[np.float64]] = field(default_factory=list)
     seconds: float = 0.0
@@ -70,7 +71,8 @@ class BatchStore:
         self.identity = dict(identity)
 
     def path(self, config: EnvConfig, seed: int, batch: int, size: int) -> Path:
-        decided = {
+        decided = {  # the version too: a batch of another layout is flown again, not misread
+            "version": BATCH_VERSION,
             "identity": self.identity,
             "config": config.model_dump(mode="json"),
             "seed": seed,

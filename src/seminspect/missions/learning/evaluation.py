@@ -24,13 +24,14 @@ from __future__ import annotations
 import hashlib
 import os
 import time
+from collections import Counter
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from scipy import stats
 
 from seminspect.core.errors import FileFormatError, InvalidInputError
@@ -42,7 +43,7 @@ from seminspect.missions.learning.batches import BatchStore, BatchTally
 from seminspect.missions.learning.env import InspectionVectorEnv
 from seminspect.missions.learning.env_config import EnvConfig, TargetShape
 from seminspect.missions.learning.feasibility import feasible_faces
-from seminspect.missions.learning.rooms import Room
+from seminspect.missions.learning.rooms import Room, struck_surface
 
 FORMAT = "seminspect.rl-evaluation"
 #: 2: strict coverage, intervals, the checkpoint's SHA-256 (version 1 is refused).
@@ -111,6 +112,9 @@ class ObstacleResult(BaseModel):
     feasible_faces: list[int]
     crashed: list[bool]
     length: list[int]
+    #: What each crash struck (one of ``rooms.SURFACES``; "" for no crash); empty in files
+    #: written before it was recorded.
+    struck: list[str] = Field(default_factory=list)
     rooms: list[str]
     #: Strict coverage % against ``curve_times``: mean, 5th and 95th percentile over the
     #: episodes, and the curves of the first ``KEPT_CURVES`` episodes.
@@ -119,6 +123,11 @@ class ObstacleResult(BaseModel):
     curve_p5: list[float]
     curve_p95: list[float]
     curves: list[list[float]]
+
+    def crashes_into(self) -> dict[str, int]:
+        """Crashes per surface struck, most first (empty when not recorded)."""
+        counts = Counter(name for name in self.struck if name)
+        return dict(counts.most_common())
 
 
 class EvaluationResult(BaseModel):
@@ -363,11 +372,16 @@ def _run_batch(
     crashed = np.zeros(env.num_envs, dtype=bool)
     timed_out = np.zeros(env.num_envs, dtype=bool)
     length = np.full(env.num_envs, steps)
+    struck = [""] * env.num_envs
     seen = [env.strict_seen()]
     for step in range(1, steps + 1):
         if not (crashed | timed_out).all():  # finished rooms are frozen: nothing left to step
             obs, _, crash, timeout, _ = env.step(controller.act(env, obs))
             length[crash] = step
+            if crash.any():
+                where = env.positions()
+                for e in np.flatnonzero(crash):
+                    struck[e] = struck_surface(env.rooms[e], where[e])
             crashed |= crash
             timed_out |= timeout
         if step % every == 0:
@@ -385,6 +399,7 @@ def _run_batch(
         crashed=crashed.tolist(),
         timed_out=timed_out.tolist(),
         length=length.tolist(),
+        struck=struck,
         rooms=fingerprints,
         curves=list(_share(100.0 * curves, counts[:, None], 100.0)),
     )
@@ -441,6 +456,7 @@ def _summarise(obstacles: int, tally: BatchTally, config: EnvConfig) -> Obstacle
         feasible_faces=tally.feasible,
         crashed=tally.crashed,
         length=tally.length,
+        struck=tally.struck,
         rooms=tally.rooms,
         curve_times=[round(i * interval, 6) for i in range(curves.shape[1])],
         curve_mean=curves.mean(axis=0).tolist(),

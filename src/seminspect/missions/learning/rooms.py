@@ -27,6 +27,7 @@ from seminspect.missions.learning.solids import (
     SPHERE,
     Solids,
     clearance,
+    solid_distance,
     surface_gap,
 )
 from seminspect.missions.learning.targets import TARGET_FACES, Target, make_target
@@ -36,6 +37,7 @@ __all__ = [
     "BOX",
     "CYLINDER",
     "SPHERE",
+    "SURFACES",
     "TABLE1_OBSTACLES",
     "TARGET_FACES",
     "Room",
@@ -44,10 +46,13 @@ __all__ = [
     "sample_room",
     "side_by_side",
     "stack_solids",
+    "struck_surface",
 ]
 
 #: Obstacle counts of 004 Table I.
 TABLE1_OBSTACLES = (0, 4, 9, 14, 19)
+#: What a crash can strike: the names :func:`struck_surface` gives.
+SURFACES = ("wall", "floor", "ceiling", "object", "obstacle")
 
 
 @dataclass(frozen=True)
@@ -75,6 +80,25 @@ class Room:
     @property
     def obstacle_count(self) -> int:
         return len(self.solids.kind) - self.target_solids
+
+
+def struck_surface(room: Room, point: NDArray[np.float64]) -> str:
+    """Which of :data:`SURFACES` of ``room`` lies nearest to ``point``: what a robot that
+    crashed there struck (a crash is a clearance below the robot's radius)."""
+    p = np.asarray(point, dtype=np.float64)
+    solids, k = room.solids, room.target_solids
+    gaps = {
+        "wall": min(p[0], p[1], room.size[0] - p[0], room.size[1] - p[1]),
+        "floor": p[2],
+        "ceiling": room.size[2] - p[2],
+        "object": solid_distance(p[None], _solid_rows(solids, slice(None, k)))[0],
+        "obstacle": solid_distance(p[None], _solid_rows(solids, slice(k, None)))[0],
+    }
+    return min(gaps, key=lambda name: gaps[name])
+
+
+def _solid_rows(solids: Solids, rows: slice) -> Solids:
+    return Solids(solids.kind[rows], solids.centre[rows], solids.rotation[rows], solids.size[rows])
 
 
 def stack_solids(rooms: list[Room]) -> Solids:
