@@ -8,7 +8,7 @@ import pytest
 from bench_scripts import BENCH, bench_script
 
 #: Scripts that need an optional extra to import at all, and the module that provides it.
-NEEDS = {"rl_policy": "torch", "rl_reproduction": "torch"}
+NEEDS = {"rl_crashes": "torch", "rl_policy": "torch", "rl_reproduction": "torch"}
 
 
 @pytest.mark.parametrize("name", sorted(p.stem for p in BENCH.glob("*.py")))
