@@ -270,7 +270,7 @@ def train_command(
         "small", "--config", help="Network: small (sized for a CPU) or paper (004 Fig 2)."
     ),
     variant: str = typer.Option(
-        "main", "--variant", help="main, no-svs (Table II) or no-gru (Table III)."
+        "main", "--variant", help="main, no-svs (Table II), no-gru or gru-512 (Table III)."
     ),
     steps: int = typer.Option(640_000, "--steps", help="Environment steps, all rooms together."),
     seed: int = _SEED,

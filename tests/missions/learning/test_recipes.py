@@ -20,8 +20,10 @@ def test_variants_ablate_one_part_each() -> None:
     assert main.use_svs and main.gru_size == 128
     assert not policy_config("small", "no-svs").use_svs
     assert policy_config("small", "no-gru").gru_size == 0
+    assert policy_config("small", "gru-512").gru_size == 512  # Table III's larger GRU
+    assert policy_config("small", "gru-512").use_svs
     assert policy_config("paper", "main").gru_size == 512
-    assert set(VARIANTS) == {"main", "no-svs", "no-gru"}
+    assert set(VARIANTS) == {"main", "no-svs", "no-gru", "gru-512"}
 
 
 def test_training_rooms_are_004s_and_follow_the_network() -> None:
@@ -36,7 +38,8 @@ def test_training_rooms_are_004s_and_follow_the_network() -> None:
 
 
 def test_the_budgets_are_5_m_steps_for_the_policy_and_2_m_per_ablation() -> None:
-    assert BUDGETS == {"main": 5_000_000, "no-svs": 2_000_000, "no-gru": 2_000_000}
+    ablations = dict.fromkeys(("no-svs", "no-gru", "gru-512"), 2_000_000)
+    assert {"main": 5_000_000, **ablations} == BUDGETS
     assert set(BUDGETS) == set(VARIANTS)
 
 
