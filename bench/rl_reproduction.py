@@ -102,6 +102,9 @@ RETRAINED_RUNS = {
     "v2-main-2m": "v2 (2.0 M steps)",
     "v2-no-svs": "v2, no SVS map (2.0 M steps)",
     "v2-no-gru": "v2, no GRU (2.0 M steps)",
+    "v3-main": "v3 (5.0 M steps)",
+    "v3-no-svs": "v3, no SVS map (2.0 M steps)",
+    "v3-no-gru": "v3, no GRU (2.0 M steps)",
 }
 EVALUATIONS |= {
     run: (CHECKPOINTS / run / "checkpoint.pt", (ABLATION_OBSTACLES,), label, "cylinder")

@@ -43,6 +43,9 @@ NEEDS = {
         "v2-main-2m",
         "v2-no-svs",
         "v2-no-gru",
+        "v3-main",
+        "v3-no-svs",
+        "v3-no-gru",
         "table1-orbit",
     ),
 }
