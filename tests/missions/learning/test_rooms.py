@@ -231,15 +231,10 @@ def test_the_surface_rule_leaves_the_robots_width_and_comes_nearer_than_v1s():
     assert np.median(near) < np.median(legacy) - 0.2
 
 
-def _solid(solids, i):
-    return Solids(solids.kind[i : i + 1], solids.centre[i : i + 1], solids.rotation[i : i + 1],
-                  solids.size[i : i + 1])  # fmt: skip
-
-
 def _apart(room, points, but=None, margin=0.3):
     """The points at least ``margin`` from every solid other than ``but`` and from the walls."""
     others = [j for j in range(len(room.solids.kind)) if j != but]
-    gaps = [solid_distance(points, _solid(room.solids, j)) for j in others]
+    gaps = [solid_distance(points, room.solids.rows(slice(j, j + 1))) for j in others]
     walls = np.minimum(points, room.size - points).min(axis=1)
     return points[np.minimum.reduce([walls, *gaps]) > margin]
 

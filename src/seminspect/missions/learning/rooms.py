@@ -91,14 +91,10 @@ def struck_surface(room: Room, point: NDArray[np.float64]) -> str:
         "wall": min(p[0], p[1], room.size[0] - p[0], room.size[1] - p[1]),
         "floor": p[2],
         "ceiling": room.size[2] - p[2],
-        "object": solid_distance(p[None], _solid_rows(solids, slice(None, k)))[0],
-        "obstacle": solid_distance(p[None], _solid_rows(solids, slice(k, None)))[0],
+        "object": solid_distance(p[None], solids.rows(slice(None, k)))[0],
+        "obstacle": solid_distance(p[None], solids.rows(slice(k, None)))[0],
     }
     return min(gaps, key=lambda name: gaps[name])
-
-
-def _solid_rows(solids: Solids, rows: slice) -> Solids:
-    return Solids(solids.kind[rows], solids.centre[rows], solids.rotation[rows], solids.size[rows])
 
 
 def stack_solids(rooms: list[Room]) -> Solids:

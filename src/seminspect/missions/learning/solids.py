@@ -31,8 +31,8 @@ class Solids:
     rotation: NDArray[np.float64]
     size: NDArray[np.float64]
 
-    def rows(self, index: NDArray[np.int64]) -> Solids:
-        """The solids of the rooms ``index`` of a batch (arrays with a leading room axis)."""
+    def rows(self, index: NDArray[np.int64] | slice) -> Solids:
+        """The rows ``index`` of the leading axis: rooms of a batch, or solids of one room."""
         return Solids(self.kind[index], self.centre[index], self.rotation[index], self.size[index])
 
 
