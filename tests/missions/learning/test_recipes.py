@@ -35,6 +35,7 @@ def test_training_rooms_are_004s_and_follow_the_network() -> None:
     assert set(env.target_shapes) == set(TARGET_SHAPES) - {"t-pipe"}  # held out, as in Sec V
     assert env.face_reward == "fraction" and env.yaw_encoding == "full-angle"  # not policy v1's
     assert env.shaping_discount == train_config(1000).gamma  # shaped for the trainer's discount
+    assert env.proximity_penalty == "contact"  # policy v4's (v3: graded)
 
 
 def test_the_budgets_are_5_m_steps_for_the_policy_and_2_m_per_ablation() -> None:

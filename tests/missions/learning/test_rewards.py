@@ -1,5 +1,5 @@
 """The reward terms of 004 eq (6) by hand: f_t's face scores (repaid and fraction), its
-shaping, v_t and p_t (binary and graded)."""
+shaping, v_t and p_t (binary, graded and by time to contact)."""
 
 import math
 
@@ -8,6 +8,7 @@ import pytest
 
 from seminspect.missions.learning.rewards import (
     collision_penalty,
+    contact_penalty,
     distance_score,
     face_scores,
     graded_penalty,
@@ -72,6 +73,28 @@ def test_the_graded_penalty_is_minus_one_within_d_coll_and_falls_linearly_to_rea
     assert graded_penalty(np.zeros((1, 5)), distance, 0.3, 0.6)[0] == 0.0
     # reach == d_coll: a step
     np.testing.assert_array_equal(graded_penalty(rows, distance, 0.3, 0.3), [-1, -1, 0, 0, 0])
+
+
+def test_the_contact_penalty_grows_as_the_time_to_contact_falls_below_the_horizon():
+    ahead, beside = [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]  # offsets of two cells, 1 m away
+    cells = np.array([ahead, beside])
+    occupied = np.array([[1.0, 0.0]])  # only the cell ahead
+    radius, horizon = 0.2, 1.0  # 0.8 m of gap
+
+    def penalty(velocity, occupancy=occupied):
+        return contact_penalty(occupancy, cells, np.array([velocity]), radius, horizon)[0]
+
+    assert penalty([1.6, 0.0, 0.0]) == pytest.approx(-0.5)  # contact in 0.5 s
+    assert penalty([0.4, 0.0, 0.0]) == 0.0  # 2 s: beyond the horizon
+    assert penalty([-1.0, 0.0, 0.0]) == 0.0  # moving away
+    assert penalty([0.0, 1.6, 0.0]) == 0.0  # toward a free cell
+    # the speed toward the cell counts, not the speed: 1.6 m/s at 60 degrees closes at 0.8
+    assert penalty([0.8, 0.8 * math.sqrt(3.0), 0.0]) == pytest.approx(0.0, abs=1e-12)
+    assert penalty([1.0e6, 0.0, 0.0]) == pytest.approx(-1.0)  # clipped at -1
+    # unknown (0.5) does not count; the soonest of several occupied cells decides
+    assert penalty([1.6, 0.0, 0.0], np.array([[0.5, 0.0]])) == 0.0
+    both = np.array([[1.0, 1.0]])
+    assert penalty([1.6, 3.2, 0.0], both) == pytest.approx(-0.75)  # beside: 0.25 s
 
 
 def test_the_distance_score_is_eq_7s_weight_and_zero_for_never_seen():

@@ -18,13 +18,12 @@ Per step (10 Hz, the paper's image rate):
   depth D_t∘S_t, the ego-centric occupancy map m^o (free 0, unknown 0.5, occupied 1; binary:
   occupied and outside the map 1, else 0) and the spatial visit score map m^h (eq (3)), both
   21^3 at 0.1 m in the yaw-aligned body frame.
-- Reward eq (6): face-mesh reward f_t (eqs (7)-(9), faces in the focus area only; the fraction
-  of faces inspected, weighted by distance, paid as is or shaped, or v1's repaid scores),
-  semantic-search reward v_t (eq (10)) and the collision penalty p_t (-1 with an occupied m^o
-  cell within d_coll; graded: rising linearly to 0 at ``penalty_reach``). Contact (true
-  clearance below the robot radius) is a crash, ends the episode and costs ``crash_penalty``
-  (and a shaped reward's potential); reaching the episode length without one is a timeout
-  (Sec IV-A). Coverage: lenient and strict (a measure only).
+- Reward eq (6): face-mesh reward f_t (eqs (7)-(9), focus-area faces only: the distance-
+  weighted fraction inspected, as is or shaped, or v1's repaid scores), semantic-search reward
+  v_t (eq (10)) and the penalty p_t (:mod:`.rewards`: binary, graded or contact). Contact (true
+  clearance below the robot radius) is a crash: it ends the episode and costs ``crash_penalty``
+  (and a shaped reward's potential); reaching the episode length is a timeout (Sec IV-A).
+  Coverage: lenient and strict (a measure only).
 
 The parts have modules of their own: :mod:`.env_config` (the settings), :mod:`.sensors`,
 :mod:`.maps`, :mod:`.rewards`, :mod:`.face_views` and :mod:`.dynamics` (with the state
@@ -44,7 +43,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.rng import make_rng
-from seminspect.geometry.transforms import world_from_body
+from seminspect.geometry.transforms import body_from_world, world_from_body
 from seminspect.missions.learning.dynamics import first_order_step, state_rows
 from seminspect.missions.learning.env_config import ACTION_SIZE, STATE_SIZE, EnvConfig
 from seminspect.missions.learning.face_views import (
@@ -63,12 +62,14 @@ from seminspect.missions.learning.maps import (
 )
 from seminspect.missions.learning.rewards import (
     collision_penalty,
+    contact_penalty,
     graded_penalty,
     semantic_search_reward,
 )
 from seminspect.missions.learning.rooms import (
     TARGET_FACES,
     Room,
+    checked_rooms,
     clearance,
     sample_room,
     side_by_side,
@@ -152,6 +153,8 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         reach = cfg.d_coll if cfg.proximity_penalty == "binary" else cfg.penalty_reach
         self._near = np.flatnonzero(radius <= reach)
         self._near_radius = radius[self._near]
+        # the contact penalty looks as far as the map reaches on every side
+        self._ahead = np.flatnonzero(radius <= cfg.map_cells // 2 * cfg.map_resolution)
         self._cell_values = BINARY_VALUES if cfg.ego_map == "binary" else THREE_STATE_VALUES
         self._spacing = self.config.largest_room[0] + ROOM_GAP  # rooms drawn smaller fit too
 
@@ -238,7 +241,7 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         if options and "obstacles" in options:
             self.set_obstacles(options["obstacles"])
         if options and "rooms" in options:
-            self._rooms = _given_rooms(options["rooms"], self.num_envs, self.config.largest_room)
+            self._rooms = checked_rooms(options["rooms"], self.num_envs, self.config.largest_room)
         else:
             self._rooms = [self._sample_room(i) for i in range(self.num_envs)]
         every = np.arange(self.num_envs)
@@ -456,6 +459,13 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
             penalty = collision_penalty(near)
         else:
             penalty = graded_penalty(near, self._near_radius, cfg.d_coll, cfg.penalty_reach)
+        if cfg.proximity_penalty == "contact":  # the map's cells lie in the yaw-aligned frame
+            velocity = body_from_world(self._velocity[envs], self._yaw[envs])
+            closing = contact_penalty(
+                occupancy[:, self._ahead], self._offsets[self._ahead], velocity,
+                cfg.robot_radius, cfg.contact_horizon,
+            )  # fmt: skip
+            penalty = np.minimum(penalty, closing)
         return semantic_search_reward(totals, cfg.gamma, cfg.delta), penalty
 
     def _fill_state(self, envs: NDArray[np.int64]) -> None:
@@ -479,15 +489,3 @@ class InspectionVectorEnv(gym.vector.VectorEnv):
         self.__dict__.update(state)
         if self._rooms:
             self._rebuild_scene()
-
-
-def _given_rooms(rooms: Sequence[Room], count: int, largest: Sequence[float]) -> list[Room]:
-    """The rooms of ``reset(options={"rooms": ...})``, one per env, each within the scene's
-    and the maps' size."""
-    given = list(rooms)
-    if len(given) != count or not all(isinstance(room, Room) for room in given):
-        raise InvalidInputError(f"options['rooms'] needs {count} Room objects, got {len(given)}")
-    for room in given:
-        if np.any(room.size > np.asarray(largest) + 1e-9):
-            raise InvalidInputError(f"room {tuple(room.size)} exceeds the largest {largest}")
-    return given

@@ -86,12 +86,17 @@ class EnvConfig(BaseModel):
         "step, and a crash forfeits the stream. The trainer's discount, so that the best "
         "policy is the stream's, credited when a face is seen; None: f_t paid as is",
     )
-    proximity_penalty: Literal["graded", "binary"] = Field(
+    proximity_penalty: Literal["graded", "binary", "contact"] = Field(
         "graded",
         description="binary (eq (6)): -1 with an occupied m^o cell within d_coll; graded: "
-        "-1 within d_coll, rising linearly to 0 at penalty_reach",
+        "-1 within d_coll, rising linearly to 0 at penalty_reach; contact (ours): the "
+        "stronger of graded and -(1 - t_c / contact_horizon), t_c the time to contact with "
+        "the occupied m^o cell the robot closes on soonest",
     )
     penalty_reach: float = Field(0.6, gt=0.0, description="graded penalty's outer edge (m)")
+    contact_horizon: float = Field(
+        1.0, gt=0.0, description="contact penalty: a time to contact below it costs (s)"
+    )
     ego_map: Literal["three-state", "binary"] = Field(
         "three-state",
         description="three-state: m^o holds free 0, unknown 0.5, occupied 1 (rays carve free "

@@ -104,3 +104,31 @@ def graded_penalty(
     nearest = np.where(occupied, cell_distance, np.inf).min(axis=1, initial=np.inf)
     span = max(reach - d_coll, 1e-9)  # reach == d_coll: a step at d_coll
     return np.where(nearest <= d_coll, -1.0, -np.clip((reach - nearest) / span, 0.0, 1.0))
+
+
+def contact_penalty(
+    near_occupancy: NDArray,
+    cell_offsets: NDArray,
+    velocity: NDArray,
+    robot_radius: float,
+    horizon: float,
+) -> NDArray[np.float64]:
+    """A penalty for closing on an occupied m^o cell: -(1 - t_c / horizon), clipped to [-1, 0].
+
+    t_c is the time to contact at the current velocity: the cell's distance less the robot
+    radius over the speed toward it, the soonest of the row's occupied cells. The graded
+    penalty reads distance only, so at 1.3 m/s (the measured crash speed) its 0.3 m zone is
+    crossed in 2-3 steps; this one grows with speed and falls to 0 when moving away.
+    ``near_occupancy`` is ``(rows, cells)``; ``cell_offsets`` the cells' ``(cells, 3)``
+    offsets from the robot and ``velocity`` the rows' ``(rows, 3)``, in one frame.
+    """
+    rows, cells = np.nonzero(np.asarray(near_occupancy) >= 1.0)  # few: walk those only
+    offsets = np.asarray(cell_offsets, dtype=np.float64)[cells]
+    distance = np.linalg.norm(offsets, axis=1)
+    along = np.einsum("ij,ij->i", np.asarray(velocity, dtype=np.float64)[rows], offsets)
+    closing = along / np.maximum(distance, 1e-9)  # speed toward each occupied cell
+    gap = np.maximum(distance - robot_radius, 0.0)
+    time_to_contact = np.where(closing > 0.0, gap / np.where(closing > 0.0, closing, 1.0), np.inf)
+    soonest = np.full(len(velocity), np.inf)
+    np.minimum.at(soonest, rows, time_to_contact)
+    return -np.clip(1.0 - soonest / horizon, 0.0, 1.0)

@@ -12,6 +12,7 @@ robot's clearance to everything in the room is exact and cheap (:func:`clearance
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cache
 
@@ -316,3 +317,15 @@ def _free_start(
         if gaps.max() > best_gap:
             best, best_gap = candidates[int(np.argmax(gaps))], float(gaps.max())
     return best
+
+
+def checked_rooms(rooms: Sequence[Room], count: int, largest: Sequence[float]) -> list[Room]:
+    """``rooms`` as a list, checked as an env's ``reset(options={"rooms": ...})`` takes them:
+    ``count`` rooms, each within the ``largest`` size its scene and maps hold."""
+    given = list(rooms)
+    if len(given) != count or not all(isinstance(room, Room) for room in given):
+        raise InvalidInputError(f"options['rooms'] needs {count} Room objects, got {len(given)}")
+    for room in given:
+        if np.any(room.size > np.asarray(largest) + 1e-9):
+            raise InvalidInputError(f"room {tuple(room.size)} exceeds the largest {largest}")
+    return given
