@@ -16,7 +16,7 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from seminspect.sensors import Detection, Frame, LidarScan
+from seminspect.sensors import Detection, Detector, Frame, LidarScan
 
 
 @dataclass(frozen=True)
@@ -68,6 +68,11 @@ class Platform(Protocol):
         """Motions stopped by an obstacle so far."""
         ...
 
+    @property
+    def detector(self) -> Detector:
+        """What segments the camera's frames (runs record its ``name``)."""
+        ...
+
     def trajectory_rows(self) -> NDArray[np.float64]:
         """``(n, 9)`` rows: time, position (3), yaw, odometry position (3), odometry yaw."""
         ...
@@ -83,7 +88,9 @@ class Platform(Protocol):
         (``Frame.intensity`` then None; a simulator may skip shading it)."""
         ...
 
-    def detect(self, frame: Frame, level: str, labels: Iterable[str]) -> list[Detection]: ...
+    def detect(self, frame: Frame, level: str, labels: Iterable[str]) -> list[Detection]:
+        """:attr:`detector`'s detections of ``labels`` (``level``: instance or part)."""
+        ...
 
     def scan(self) -> LidarScan: ...
 

@@ -1,5 +1,6 @@
 """The simulated robot behind the :class:`~seminspect.platform.protocol.Platform` protocol: a
-:class:`Robot` with a camera, a segmentation model and a LiDAR in a :class:`World`."""
+:class:`Robot` with a camera, a detector (:mod:`seminspect.sensors.detector`) and a LiDAR in a
+:class:`World`."""
 
 from __future__ import annotations
 
@@ -21,8 +22,9 @@ from seminspect.platform.protocol import Motion
 from seminspect.robot import Robot
 from seminspect.robot.robot import MoveResult
 from seminspect.sensors import CameraModel, Detection, Frame, Lidar, LidarScan, render
+from seminspect.sensors.detector import Detector, TruthDetector
 from seminspect.sensors.noise import NoiseModel, NormalStream, make_noise
-from seminspect.sensors.segmentation import detect
+from seminspect.sensors.segmentation import as_level
 from seminspect.worlds import World
 
 
@@ -54,6 +56,7 @@ class SimulatedPlatform:
         capture_s: float = 0.1,
         name: str | None = None,
         threads: int = 1,
+        detector: Detector | None = None,
     ) -> None:
         # A named robot (one of a team) draws its noise from streams of its own.
         streams = () if name is None else (name,)
@@ -80,7 +83,10 @@ class SimulatedPlatform:
         )
         # The camera's noise is drawn ahead, off the mission's thread (the same numbers).
         self._camera_rng = NormalStream(make_rng(seed, "sensors", "camera", *streams), threads)
-        self._detector_rng = make_rng(seed, "sensors", "segmentation", *streams)
+        #: What segments the camera's frames (the simulator's labels unless given).
+        self.detector: Detector = detector or TruthDetector(
+            world, noise, make_rng(seed, "sensors", "segmentation", *streams)
+        )
         self._lidar_rng = make_rng(seed, "sensors", "lidar", *streams)
         self.frames = 0
         self.scans = 0
@@ -184,19 +190,7 @@ class SimulatedPlatform:
 
     def detect(self, frame: Frame, level: str, labels: Iterable[str]) -> list[Detection]:
         """Segment objects (``level="instance"``, by class) or parts (``"part"``, by part name)."""
-        wanted = tuple(labels)
-        if level == "instance":
-            return detect(
-                frame,
-                self.world,
-                "instance",
-                classes=wanted,
-                noise=self.noise,
-                rng=self._detector_rng,
-            )
-        return detect(
-            frame, self.world, "part", parts=wanted, noise=self.noise, rng=self._detector_rng
-        )
+        return self.detector.detect(frame, as_level(level), tuple(labels))
 
     def scan(self) -> LidarScan:
         """A LiDAR scan, expressed in the robot's odometry frame."""

@@ -1,6 +1,8 @@
-"""Simulated sensors: ray-cast depth + segmentation camera, intensity image, LiDAR, noise models."""
+"""Simulated sensors: ray-cast depth + segmentation camera, intensity image, the detector seam,
+LiDAR, noise models."""
 
 from seminspect.sensors.camera import CameraModel, Frame, render
+from seminspect.sensors.detector import Detector, TruthDetector
 from seminspect.sensors.lidar import Lidar, LidarScan
 from seminspect.sensors.noise import NoiseModel, make_noise, noise_preset, require_rng
 from seminspect.sensors.segmentation import Detection, detect, detect_instances, detect_parts
@@ -8,10 +10,12 @@ from seminspect.sensors.segmentation import Detection, detect, detect_instances,
 __all__ = [
     "CameraModel",
     "Detection",
+    "Detector",
     "Frame",
     "Lidar",
     "LidarScan",
     "NoiseModel",
+    "TruthDetector",
     "detect",
     "detect_instances",
     "detect_parts",

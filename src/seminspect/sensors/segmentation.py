@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any, Literal, cast
 
 import cv2
 import numba
@@ -54,6 +54,13 @@ class Detection:
     @property
     def is_false_positive(self) -> bool:
         return self.instance_id < 0
+
+
+def as_level(level: str) -> Level:
+    """``level`` checked: ``"instance"`` or ``"part"``."""
+    if level in {"instance", "part"}:
+        return cast("Level", level)
+    raise InvalidInputError(f"detection level must be 'instance' or 'part', got {level!r}")
 
 
 Window = tuple[slice, slice]
@@ -231,8 +238,7 @@ def detect(
         noise: segmentation faults (``None``: ideal).
         rng: generator for the faults; required when the noise model is not ideal.
     """
-    if level not in ("instance", "part"):
-        raise InvalidInputError(f"detection level must be 'instance' or 'part', got {level!r}")
+    level = as_level(level)
     model = noise or NoiseModel()
     generator = None if model.is_ideal else require_rng(rng)
     key, candidates, boxes = _keys(frame, world, level, classes, parts)

@@ -75,6 +75,9 @@ def test_metrics_json_reads_back_as_the_typed_metrics(small_mission, small_missi
     data = read_versioned_json(small_mission_dir / "metrics.json", "seminspect.run-metrics", [1])
     assert MissionMetrics.from_json(data) == small_mission.metrics
     assert set(data["mission"]) >= {"level_endings", "wall_time_by_category_s"}
+    assert data["world"]["detector"] == "truth"  # which detector saw the run
+    older = {**data, "world": {k: v for k, v in data["world"].items() if k != "detector"}}
+    assert MissionMetrics.from_json(older).world.detector == "truth"  # before the seam
 
 
 def test_operator_queries_are_answered_and_driven(small_mission) -> None:

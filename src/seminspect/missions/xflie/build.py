@@ -15,6 +15,7 @@ from seminspect.missions.xflie.features import warn_about_feature_labels
 from seminspect.missions.xflie.frontier import FrontierMission
 from seminspect.platform.simulated import SimulatedPlatform, mission_noise
 from seminspect.runs.directory import RunDirectory
+from seminspect.sensors import Detector
 from seminspect.worlds import World, open_world
 from seminspect.worlds.catalog import is_world_path
 from seminspect.worlds.checks import warn_if_no_targets
@@ -41,13 +42,15 @@ def build_mission(
     run: RunDirectory | None,
     progress: Callable[[MissionProgress], None] | None = None,
     world: World | None = None,
+    detector: Detector | None = None,
 ) -> tuple[XFlie, World]:
-    """The world (made from ``config`` unless given), the robot in it and the executive."""
+    """The world (made from ``config`` unless given), the robot in it and the executive; the
+    robot sees through ``detector`` (default: the simulator's labels with the fault model)."""
     world = world or open_world(config.world, config.scenario, seed=config.seed)
     warn_if_no_targets(world, config.target_classes)
     if inspects(config.planner):
         warn_about_feature_labels(world, config.target_classes, config.feature_labels)
-    platform, ground_z = build_platform(config, world)
+    platform, ground_z = build_platform(config, world, detector=detector)
     occupancy = mission_map(world, config)
     executive = XFlie if inspects(config.planner) else FrontierMission
     mission = executive(config, platform, occupancy, ground_z=ground_z, run=run, progress=progress)
@@ -55,7 +58,10 @@ def build_mission(
 
 
 def build_platform(
-    config: ResolvedMissionConfig, world: World, name: str | None = None
+    config: ResolvedMissionConfig,
+    world: World,
+    name: str | None = None,
+    detector: Detector | None = None,
 ) -> tuple[SimulatedPlatform, float]:
     """The simulated robot at the world's start, and the height of the ground it stands on;
     a ``name`` gives a robot of a team noise streams of its own."""
@@ -76,6 +82,7 @@ def build_platform(
         camera_pitch=math.radians(camera_pitch(config)),
         name=name,
         threads=sensor_threads(),
+        detector=detector,
     )
     return platform, float(platform.position[2] - start_height)
 

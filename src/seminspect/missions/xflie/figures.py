@@ -59,7 +59,7 @@ def mission_metrics(
     return MissionMetrics(
         state,
         reason,
-        RunIdentity(config.world, config.scenario, config.seed),
+        RunIdentity(config.world, config.scenario, config.seed, mission.platform.detector.name),
         graph_figures(mission, score, [r.seconds for r in record.plans]),
         quality_figures(mission, world, cpu, score),
         target_figures(score, mission.unreachable),

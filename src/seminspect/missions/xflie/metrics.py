@@ -141,11 +141,12 @@ class QueryAnswer:
 
 @dataclass(frozen=True)
 class RunIdentity:
-    """Which world, scenario and seed a run explored."""
+    """Which world, scenario and seed a run explored, and the detector that saw it."""
 
     name: str
     scenario: str | None
     seed: int
+    detector: str = "truth"  # runs before the detector seam had only the simulator's labels
 
 
 @dataclass(frozen=True)

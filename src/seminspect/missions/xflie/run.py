@@ -32,6 +32,7 @@ from seminspect.missions.xflie.team_run import run_team
 from seminspect.planning.routes import warm_up
 from seminspect.runs.conduct import RunEnd, conduct_run
 from seminspect.runs.directory import RunDirectory
+from seminspect.sensors import Detector
 from seminspect.worlds import World, open_world
 
 
@@ -42,8 +43,10 @@ def run_mission(
     base: str | os.PathLike[str] = "runs",
     queries: Sequence[str] = (),
     progress: Callable[[MissionProgress], None] | None = None,
+    detector: Detector | None = None,
 ) -> MissionResult:
-    """Run a mission into ``out`` (default: a fresh directory under ``base``).
+    """Run a mission into ``out`` (default: a fresh directory under ``base``), every robot
+    seeing through ``detector`` (default: the simulator's labels with the fault model).
 
     The world is made first, so a bad world or scenario creates no directory. ``out`` is then
     claimed (see :meth:`RunDirectory.claimed`): a second run on it fails at once, and files of an
@@ -59,8 +62,8 @@ def run_mission(
         )
         with run.claimed(config.model_dump(mode="json")):
             if config.robots:
-                return run_team(run, config, world, queries, progress)
-            return _run(run, config, world, queries, progress)
+                return run_team(run, config, world, queries, progress, detector=detector)
+            return _run(run, config, world, queries, progress, detector=detector)
 
 
 def _run(
@@ -69,8 +72,10 @@ def _run(
     world: World,
     queries: Sequence[str],
     progress: Callable[[MissionProgress], None] | None,
+    *,
+    detector: Detector | None,
 ) -> MissionResult:
-    mission, world = build_mission(config, run, progress, world)
+    mission, world = build_mission(config, run, progress, world, detector=detector)
     warm_up()  # compile before the clock starts: a fresh install times plans, not numba
     cpu = CpuMeter()
     answers: list[QueryAnswer] = []

@@ -45,6 +45,7 @@ from seminspect.missions.xflie.team import Activity, Team, TeamRobot
 from seminspect.planning.routes import warm_up
 from seminspect.runs.conduct import RunEnd, conduct_run
 from seminspect.runs.directory import RunDirectory
+from seminspect.sensors import Detector
 from seminspect.worlds import World
 from seminspect.worlds.checks import warn_if_no_targets
 
@@ -77,6 +78,7 @@ def build_team(
     world: World,
     run: RunDirectory | None,
     progress: Callable[[MissionProgress], None] | None = None,
+    detector: Detector | None = None,
 ) -> Team:
     """Both robots at the world's start, on one graph and one occupancy map, with their own
     clocks: they start at the same pose, so their frames coincide, and each maps for the
@@ -88,7 +90,7 @@ def build_team(
     warn_about_feature_labels(world, config.target_classes, config.feature_labels)
     shared_map = mission_map(world, config)
     for role in ("explorer", "inspector"):
-        platform, ground_z = build_platform(config, world, name=role)
+        platform, ground_z = build_platform(config, world, name=role, detector=detector)
         mission = XFlie(
             config,
             platform,
@@ -129,9 +131,11 @@ def run_team(
     world: World,
     queries: Sequence[str],
     progress: Callable[[MissionProgress], None] | None,
+    *,
+    detector: Detector | None = None,
 ) -> MissionResult:
     """Run a team mission into ``run`` (claimed by the caller); queries go to the inspector."""
-    team = build_team(config, world, run, progress)
+    team = build_team(config, world, run, progress, detector)
     warm_up()
     cpu = CpuMeter()
     inspector = team.inspector.mission
@@ -173,7 +177,7 @@ def team_metrics(
     team_figures = MissionMetrics(
         end.state,
         end.reason,
-        RunIdentity(config.world, config.scenario, config.seed),
+        RunIdentity(config.world, config.scenario, config.seed, inspector.platform.detector.name),
         graph_figures(inspector, score, plans),
         quality_figures(inspector, world, cpu, score),
         target_figures(score, inspector.unreachable),
