@@ -211,21 +211,6 @@ def test_a_crash_is_a_clearance_below_the_robot_radius(monkeypatch, gap, crashed
     assert ("episode" in info) == crashed
 
 
-def test_the_contact_penalty_reads_the_velocity_in_the_ego_maps_frame():
-    """A cell 0.8 m along +y of the room, the robot facing +y (yaw pi/2) and moving at 1.2
-    m/s toward it: 0.6 m of gap, contact in 0.5 s, so -0.5 with a 1 s horizon (the graded
-    penalty reads 0 beyond 0.6 m); moving along x instead, nothing."""
-    env = InspectionVectorEnv(1, EnvConfig(**QUIET, proximity_penalty="contact"), seed=0)
-    env.reset(seed=0)
-    for velocity, expected in (((0.0, 1.2, 0.0), -0.5), ((1.2, 0.0, 0.0), 0.0)):
-        _place(env, (5.05, 5.05, 2.05), yaw=math.pi / 2)
-        env._velocity[0] = velocity
-        env._occupancy[0] = FREE
-        env._occupancy[0, 20, 58, 50] = OCCUPIED
-        _, penalty = env._fill_maps(np.array([0]))
-        assert penalty[0] == pytest.approx(expected, abs=1e-9), velocity
-
-
 @pytest.mark.parametrize(("gap", "crashed"), [(-0.005, True), (0.005, False)])
 def test_a_robot_crashes_by_its_own_smaller_rooms_walls(monkeypatch, gap, crashed):
     """Rooms drawn 4-5 m wide: the far wall is the room's own, not room_size's 10 m."""
