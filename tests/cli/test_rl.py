@@ -94,6 +94,16 @@ def test_train_writes_a_checkpoint_that_eval_can_fly(capsys, tmp_path):
 
     trained = read_checkpoint(run_dir / "checkpoint.pt").env_config
     assert result.config == evaluation_config(trained)  # what it saw in training, our rooms
+    tuned_dir = tmp_path / "tuned"
+    parent = run_dir / "checkpoint.pt"
+    code, stdout, err = run(
+        capsys, "rl", "train", "--init-from", str(parent), "--steps", "256", "--envs", "4",
+        "--out", str(tuned_dir),
+    )  # fmt: skip
+    assert code == 0, err
+    tuned = read_checkpoint(tuned_dir / "checkpoint.pt")
+    assert tuned.train_config is not None and tuned.train_config.init_from == file_sha256(parent)
+    assert tuned.train_config.curriculum == ((0.0, 9),)  # nine obstacles from the first step
 
 
 @pytest.mark.parametrize(
@@ -104,6 +114,8 @@ def test_train_writes_a_checkpoint_that_eval_can_fly(capsys, tmp_path):
         (["--envs", "6"], "multiple of minibatches"),
         (["--device", "gpu"], "not a torch device"),
         (["--steps", "0"], "--steps must be at least 1"),
+        (["--init-from", "missing.pt"], "no such file"),
+        (["--init-from", "missing.pt", "--variant", "no-gru"], "drop --config and --variant"),
     ],
 )
 def test_train_refuses_bad_settings_in_one_line(capsys, tmp_path, args, message):

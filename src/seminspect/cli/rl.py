@@ -260,7 +260,7 @@ def env_config_for(controller: object) -> EnvConfig:
 
 
 #: Options that set up a new run: with --resume the saved run's own settings hold.
-_NEW_RUN_OPTIONS = ("config", "variant", "steps", "seed", "envs", "device", "out")
+_NEW_RUN_OPTIONS = ("config", "variant", "steps", "seed", "envs", "device", "out", "init_from")
 
 
 @app.command("train")
@@ -284,6 +284,12 @@ def train_command(
         "--resume",
         help="Continue the run in this directory from its last saved state, with its settings.",
     ),
+    init_from: Path | None = typer.Option(
+        None,
+        "--init-from",
+        help="Fine-tune: start from this checkpoint's weights and network (9 obstacles "
+        "from the first step; the run records the checkpoint's SHA-256).",
+    ),
     max_minutes: float | None = typer.Option(
         None,
         "--max-minutes",
@@ -306,11 +312,15 @@ def train_command(
             )
         _resume_run(resume, stop_after_s)
         return
+    if init_from is not None and (_given(ctx, "config") or _given(ctx, "variant")):
+        raise InvalidInputError(
+            "--init-from takes the checkpoint's network; drop --config and --variant"
+        )
     if out is None:
         raise InvalidInputError("--out is needed for a new run (or --resume DIR to continue one)")
     if steps < 1:
         raise InvalidInputError(f"--steps must be at least 1, got {steps}")
-    _new_run(config, variant, steps, seed, envs, device, out, stop_after_s)
+    _new_run(config, variant, steps, seed, envs, device, out, stop_after_s, init_from)
 
 
 def _given(ctx: typer.Context, name: str) -> bool:
@@ -328,8 +338,11 @@ def _new_run(
     device: str,
     out: Path,
     stop_after_s: float | None,
+    init_from: Path | None,
 ) -> None:
     from seminspect.cli._common import writable_directory
+    from seminspect.core.io import file_sha256
+    from seminspect.missions.learning.checkpoints import read_checkpoint
     from seminspect.missions.learning.env import InspectionVectorEnv
     from seminspect.missions.learning.ppo import train
     from seminspect.missions.learning.recipes import (
@@ -339,8 +352,13 @@ def _new_run(
     )
 
     _check_device(device)
-    network = policy_config(config, variant)  # type: ignore[arg-type]
-    settings = train_config(steps, seed=seed, num_envs=envs)
+    initial = None if init_from is None else read_checkpoint(init_from).policy
+    if initial is None:
+        network = policy_config(config, variant)  # type: ignore[arg-type]
+    else:
+        network = initial.config
+    parent = None if init_from is None else file_sha256(init_from)
+    settings = train_config(steps, seed=seed, num_envs=envs, init_from=parent)
     rooms = training_env_config(network)
     writable_directory(out)
 
@@ -357,9 +375,11 @@ def _new_run(
             progress=progress,
             device=device,
             stop_after_s=stop_after_s,
+            initial=initial,
         )
 
-    _train_with_bar(f"{config}/{variant}", settings.total_steps, out, run)
+    label = f"{config}/{variant}" if init_from is None else f"fine-tune of {init_from}"
+    _train_with_bar(label, settings.total_steps, out, run)
 
 
 def _resume_run(run_dir: Path, stop_after_s: float | None) -> None:

@@ -96,6 +96,29 @@ def test_logs_and_checkpoint_are_written(tmp_path: Path) -> None:
     assert checkpoint.policy_config == PolicyConfig.small()
 
 
+def test_a_fine_tune_starts_from_the_weights_it_is_given(tmp_path: Path) -> None:
+    """Three updates from a trained policy at a learning rate too small to move it: the
+    checkpoint holds the initial weights, not the seed's fresh ones; another network is
+    refused before anything is written."""
+    run(tmp_path / "parent", updates=3)
+    parent = read_checkpoint(tmp_path / "parent" / "checkpoint.pt").policy
+    config = TrainConfig.model_validate(QUICK | {"total_steps": 3 * 128, "lr": 1e-12})
+    train(TargetReachEnv, PolicyConfig.small(), config, tmp_path / "fresh", env_config=ROOMS)
+    tuned = config.model_copy(update={"init_from": "ab" * 32})
+    out = tmp_path / "tuned"
+    train(TargetReachEnv, PolicyConfig.small(), tuned, out, env_config=ROOMS, initial=parent)
+    weights = read_checkpoint(out / "checkpoint.pt")
+    fresh = read_checkpoint(tmp_path / "fresh" / "checkpoint.pt").policy.state_dict()
+    for name, value in parent.state_dict().items():
+        torch.testing.assert_close(weights.policy.state_dict()[name], value, atol=1e-6, rtol=0)
+    assert any(not torch.equal(fresh[n], v) for n, v in parent.state_dict().items())
+    assert weights.train_config is not None and weights.train_config.init_from == "ab" * 32
+    with pytest.raises(InvalidInputError, match="another network"):
+        other = PolicyConfig.small(gru_size=0)
+        train(TargetReachEnv, other, tuned, tmp_path / "other", env_config=ROOMS, initial=parent)
+    assert not (tmp_path / "other" / "checkpoint.pt").exists()
+
+
 def test_the_curriculum_adds_obstacles_as_training_goes(tmp_path: Path) -> None:
     rows, envs = run(tmp_path, updates=4, curriculum=((0.0, 0), (0.25, 4), (0.5, 9)))
     assert envs[0].obstacle_calls == [0, 4, 9]

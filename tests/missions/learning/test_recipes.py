@@ -56,3 +56,12 @@ def test_only_budget_and_seed_vary_between_runs() -> None:
 def test_unknown_names_are_refused(size: str, variant: str) -> None:
     with pytest.raises(InvalidInputError):
         policy_config(size, variant)  # type: ignore[arg-type]
+
+
+def test_a_fine_tune_flies_nine_obstacles_from_its_first_step_and_names_its_parent() -> None:
+    tuned = train_config(1_000_000, init_from="cd" * 32)
+    assert tuned.curriculum == ((0.0, 9),) and tuned.init_from == "cd" * 32
+    assert train_config(1_000_000).init_from is None
+    assert tuned.model_copy(
+        update={"curriculum": train_config(1).curriculum, "init_from": None}
+    ) == (train_config(1_000_000))  # otherwise the recipe's settings

@@ -300,9 +300,12 @@ def train(
     progress: Callable[[ProgressRow], None] | None = None,
     device: torch.device | str = "cpu",
     stop_after_s: float | None = None,
+    initial: InspectionPolicy | None = None,
 ) -> TrainResult:
     """Train a policy; ``make_env(num_envs, seed)`` builds the vector environment, whose
-    settings ``env_config`` names (each checkpoint records them).
+    settings ``env_config`` names (each checkpoint records them). ``initial``: a policy of
+    ``policy_config`` whose weights the run starts from (a fine-tune; ``train_config.init_from``
+    names its checkpoint), else fresh ones.
 
     ``device`` holds the network and the rollout ("cuda" for the paper preset where a GPU is
     available); the environment stays on the CPU. Only the CPU is tested here.
@@ -324,6 +327,10 @@ def train(
     with _torch_threads(train_config.threads):
         torch.manual_seed(_torch_seed(train_config.seed, "init"))
         policy = InspectionPolicy(policy_config).to(device)
+        if initial is not None:
+            if initial.config != policy_config:
+                raise InvalidInputError("the initial policy is another network than the run's")
+            policy.load_state_dict(initial.state_dict())
         env = make_env(train_config.num_envs, train_config.seed)
         run = _Run(env, policy, train_config, env_config)
         return _drive(run, out, ProgressLog(out), progress, stop_after_s)

@@ -37,6 +37,8 @@ TRAINING_SHAPES: tuple[TargetShape, ...] = ("cylinder", "box", "sphere")
 #: 004 Sec IV-A sets up an obstacle curriculum without giving its schedule; this one is ours:
 #: (fraction of training, obstacle count), ending at the paper's nine.
 CURRICULUM = ((0.0, 0), (0.2, 4), (0.45, 9))
+#: A fine-tune starts from a policy trained through the curriculum: the paper's nine at once.
+FINE_TUNE_CURRICULUM = ((0.0, 9),)
 #: PPO's discount, and so the potential of the shaped face reward (EnvConfig.shaping_discount).
 DISCOUNT = 0.99
 
@@ -67,8 +69,11 @@ def training_env_config(policy: PolicyConfig) -> EnvConfig:
     )
 
 
-def train_config(steps: int, seed: int = 0, num_envs: int = 64) -> TrainConfig:
-    """PPO settings of every run (only the budget and the seed vary)."""
+def train_config(
+    steps: int, seed: int = 0, num_envs: int = 64, init_from: str | None = None
+) -> TrainConfig:
+    """PPO settings of every run (only the budget and the seed vary); a fine-tune of the
+    checkpoint with SHA-256 ``init_from`` flies nine obstacles from its first step."""
     return TrainConfig(
         total_steps=steps,
         num_envs=num_envs,
@@ -77,5 +82,6 @@ def train_config(steps: int, seed: int = 0, num_envs: int = 64) -> TrainConfig:
         gamma=DISCOUNT,
         seed=seed,
         checkpoint_every=100_000,
-        curriculum=CURRICULUM,
+        curriculum=CURRICULUM if init_from is None else FINE_TUNE_CURRICULUM,
+        init_from=init_from,
     )

@@ -37,6 +37,11 @@ class TrainConfig(BaseModel):
     curriculum: tuple[tuple[float, int], ...] = ((0.0, 0), (0.25, 4), (0.5, 9))
     checkpoint_every: int = Field(100_000, gt=0, strict=True, description="environment steps")
     seed: int = Field(0, ge=0, strict=True)
+    init_from: str | None = Field(
+        None,
+        description="SHA-256 of the checkpoint whose weights the run started from (a fine-tune); "
+        "None: fresh weights",
+    )
     threads: int = Field(
         1, gt=0, strict=True, description="torch threads (the envs share the cores)"
     )
