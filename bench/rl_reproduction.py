@@ -105,6 +105,7 @@ RETRAINED_RUNS = {
     "v3-main": "v3 (5.0 M steps)",
     "v3-no-svs": "v3, no SVS map (2.0 M steps)",
     "v3-no-gru": "v3, no GRU (2.0 M steps)",
+    "v3-gru-512": "v3, GRU 512 (2.0 M steps)",
 }
 EVALUATIONS |= {
     run: (CHECKPOINTS / run / "checkpoint.pt", (ABLATION_OBSTACLES,), label, "cylinder")

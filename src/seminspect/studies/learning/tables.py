@@ -46,6 +46,7 @@ NEEDS = {
         "v3-main",
         "v3-no-svs",
         "v3-no-gru",
+        "v3-gru-512",
         "table1-orbit",
     ),
 }
