@@ -353,7 +353,7 @@ def _new_run(
 
     _check_device(device)
     initial = None if init_from is None else read_checkpoint(init_from).policy
-    network = initial.config if initial else policy_config(config, variant)  # type: ignore[arg-type]
+    network = initial.config if initial is not None else policy_config(config, variant)  # type: ignore[arg-type]
     parent = None if init_from is None else file_sha256(init_from)
     settings = train_config(steps, seed=seed, num_envs=envs, init_from=parent)
     rooms = training_env_config(network)
