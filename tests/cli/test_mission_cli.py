@@ -100,3 +100,57 @@ def test_features_choose_the_parts_recorded_and_the_rest_are_named(capsys, tmp_p
     assert config["config"]["feature_labels"] == ["windows"]
     code, _, err = run(capsys, "mission", "--features", "a/b", "--out", str(tmp_path / "bad"))
     assert code != 0 and "invalid semantic label 'a/b'" in err and "Traceback" not in err
+
+
+#: The figures of metrics.json that measure the computer, not the mission.
+WALL_CLOCK = {
+    "avg_planning_time_ms", "cpu_load_pct", "planning_load_pct", "wall_time_s",
+    "real_time_factor", "local_planning_ms_mean", "planning_wall_s", "wall_time_by_category_s",
+}  # fmt: skip
+
+
+def _mission_figures(document):
+    if isinstance(document, dict):
+        return {k: _mission_figures(v) for k, v in document.items() if k not in WALL_CLOCK}
+    return document
+
+
+def _files(run_dir: Path) -> list[Path]:
+    return sorted(p.relative_to(run_dir) for p in run_dir.rglob("*") if p.is_file())
+
+
+@pytest.mark.slow
+def test_record_mcap_adds_the_recording_and_changes_no_other_output(capsys, tmp_path) -> None:
+    pytest.importorskip("rosbags", reason="the 'ros' extra (rosbags) is not installed")
+    mission = ("mission", "--world", "subterranean", "--budget", "25", "--no-pictures")
+    plain, recorded = tmp_path / "plain", tmp_path / "recorded"
+    assert run(capsys, *mission, "--out", str(plain))[0] == 0
+    code, text, _ = run(capsys, *mission, "--record-mcap", "--out", str(recorded))
+    assert code == 0 and f"MCAP recording: {recorded / 'run.mcap'}" in text
+    assert _files(recorded) == sorted([*_files(plain), Path("run.mcap")])
+    # status.json and summary.md tell the wall-clock time and the process, which differ anyway
+    for name in set(_files(plain)) - {Path("status.json"), Path("summary.md")}:
+        if name.name == "metrics.json":
+            figures = [json.loads((d / name).read_text()) for d in (plain, recorded)]
+            assert _mission_figures(figures[0]) == _mission_figures(figures[1])
+        else:
+            assert (plain / name).read_bytes() == (recorded / name).read_bytes(), name
+
+
+@pytest.mark.slow
+def test_a_failed_recording_is_one_line_and_leaves_no_file(capsys, tmp_path, monkeypatch) -> None:
+    pytest.importorskip("rosbags", reason="the 'ros' extra (rosbags) is not installed")
+    from seminspect.core.errors import InvalidInputError
+
+    def unplugged(*args, **kwargs):
+        raise InvalidInputError("camera unplugged")
+
+    monkeypatch.setattr("seminspect.missions.xflie.recording.render", unplugged)
+    out = tmp_path / "run"
+    code, text, err = run(
+        capsys, "mission", "--world", "subterranean", "--budget", "25", "--no-pictures",
+        "--record-mcap", "--out", str(out),
+    )  # fmt: skip
+    assert code == 1 and "completed" in text and f"results: {out}" in text
+    assert err.strip() == "error: camera unplugged"
+    assert not [p for p in out.iterdir() if "mcap" in p.name]

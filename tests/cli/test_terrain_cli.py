@@ -82,7 +82,8 @@ def test_errors_are_one_line_and_exit_non_zero(
 
 def test_a_bag_becomes_a_cloud_and_then_a_graph(capsys, tmp_path, labelled_scene, fake_encoder):
     pytest.importorskip("rosbags", reason="the 'ros' extra (rosbags) is not installed")
-    from seminspect.mapping.formats.rosbag import BagScan, BagTopics, write_bag
+    from seminspect.mapping.formats.rosbag import BagScan
+    from seminspect.mapping.formats.rosbag_writer import BagTopics, write_bag
     from seminspect.mapping.semantic_cloud import load_cloud
 
     points, labels, names = labelled_scene

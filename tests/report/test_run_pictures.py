@@ -1,7 +1,8 @@
 import matplotlib.pyplot as plt
 import pytest
 
-from seminspect.report.run_pictures import load_events, render_run, timeline_figure
+from seminspect.report.run_pictures import render_run, timeline_figure
+from seminspect.runs.directory import load_events
 from seminspect.runs.trajectory import load_trajectory
 
 

@@ -89,6 +89,8 @@ def test_a_new_run_clears_the_old_runs_files_but_never_a_strangers(tmp_path) -> 
     (root / "images" / "car-1-00003.jpg").write_bytes(b"jpg")
     (root / "graph.png").write_bytes(b"png")
     (root / ".metrics.json.k2j4h1.tmp").write_text("{")  # an atomic write cut short
+    (root / ".map.npz.bag.partial").mkdir()  # a bag written beside its name, cut short
+    (root / ".map.npz.bag.partial" / "metadata.yaml").write_text("")
     with RunDirectory(root, LAYOUT).claimed(CONFIG) as run:
         assert sorted(p.name for p in root.iterdir()) == ["config.json", LOCK_FILE, "status.json"]
         run.finish("completed")

@@ -85,6 +85,12 @@ _RESUME_OPTION = typer.Option(
 _BAG_OPTION = typer.Option(
     None, "--bag", help="Replay the run's LiDAR stream into this new ROS2 bag (directory)."
 )
+_RECORD_MCAP_OPTION = typer.Option(
+    False,
+    "--record-mcap",
+    help="When the mission ends, write run.mcap into the run directory: its poses, LiDAR, "
+    "camera, 3DLSG and events as ROS 2 messages, for Foxglove (File > Open local file).",
+)
 _FEATURES_OPTION = typer.Option(
     None,
     "--features",
@@ -114,6 +120,7 @@ def app(
     pictures: bool = _PICTURES_OPTION,
     resume: Path | None = _RESUME_OPTION,
     bag: Path | None = _BAG_OPTION,
+    record_mcap: bool = _RECORD_MCAP_OPTION,
     robots: str | None = _ROBOTS_OPTION,
     features: str | None = _FEATURES_OPTION,
 ) -> None:
@@ -148,6 +155,8 @@ def app(
     if bag is not None and result.state == "completed":
         _export_bag(result.run_dir, bag)
     _print_result(result)
+    if record_mcap and result.stop_signal != signal.SIGTERM:
+        _record_mcap(result.run_dir)
     if result.state == "interrupted":
         exit_stopped(result.stop_signal, result.run_dir)
 
@@ -248,6 +257,25 @@ def _export_bag(run_dir: Path, bag: Path) -> None:
             run_dir, bag, on_scan=lambda d, n: progress.update(task, completed=d, total=n)
         )
     console.print(f"ROS2 bag: {bag} (/points PointCloud2 with labels, /odom Odometry)")
+
+
+def _record_mcap(run_dir: Path) -> None:
+    from rich.progress import Progress, TextColumn
+
+    from seminspect.missions.xflie.recording import record_run
+
+    simulated = TextColumn("{task.completed:.0f}/{task.total:.0f} s simulated")
+    columns = (*Progress.get_default_columns()[:2], simulated)
+    with Progress(*columns, console=err_console, transient=True) as progress:
+        task = progress.add_task("recording run.mcap", total=1.0)
+        path = record_run(
+            run_dir, on_progress=lambda t, end: progress.update(task, completed=t, total=end)
+        )
+    size_mb = path.stat().st_size / 1e6
+    console.print(
+        f"MCAP recording: {path} ({size_mb:.1f} MB; Foxglove: File > Open local file)",
+        soft_wrap=True,
+    )
 
 
 def _print_result(result) -> None:

@@ -33,7 +33,8 @@ from seminspect.report.html_page import (
     write_page,
 )
 from seminspect.report.lsg import LAYER_ORDER, layer_heights, lifted_position
-from seminspect.report.run_pictures import load_events, utility_series
+from seminspect.report.run_pictures import utility_series
+from seminspect.runs.directory import load_events
 from seminspect.runs.trajectory import load_trajectory
 from seminspect.worlds import World
 

@@ -11,7 +11,6 @@ A team run's trajectory picture draws every robot's true path in a colour of its
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Mapping
 from pathlib import Path
@@ -24,16 +23,9 @@ from seminspect.missions.xflie.layout import load_run_world
 from seminspect.report.figures import new_figure, save_figure
 from seminspect.report.lsg import draw_layers
 from seminspect.report.worlds import draw_top_down
+from seminspect.runs.directory import load_events
 from seminspect.runs.trajectory import load_robot_trajectories, load_trajectory
 from seminspect.worlds import World
-
-
-def load_events(run_dir: Path) -> list[dict]:
-    path = run_dir / "events.jsonl"
-    if not path.exists():
-        return []
-    return [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines() if line]
-
 
 #: Colours of a team's robots and of their activities on the timeline.
 ROBOT_COLOURS = {"explorer": "tab:green", "inspector": "tab:purple"}

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import json
 import os
 import re
 import shutil
@@ -113,8 +114,11 @@ class RunLayout:
 
     def wrote(self, entry: Path) -> bool:
         """Whether ``entry`` (a file or folder of a run directory) is one a run of this layout
-        writes, or the leftover of an atomic write of one that was cut short."""
+        writes, or the leftover of an atomic write of one that was cut short (a file, or the
+        directory a bag is written in before its file is renamed out of it)."""
         if entry.is_dir() and not entry.is_symlink():
+            if self._leftover(entry.name):
+                return True
             pattern = self._folders.get(entry.name)
             return pattern is not None and all(
                 pattern.fullmatch(f.name) or self._leftover(f.name) for f in entry.iterdir()
@@ -362,3 +366,11 @@ def clear_previous_run(root: Path, layout: RunLayout) -> None:
 def read_run_config(run_dir: Path) -> dict[str, Any]:
     """The resolved configuration a run was made with, as its program recorded it."""
     return read_versioned_json(run_dir / "config.json", CONFIG_FORMAT, [1])["config"]
+
+
+def load_events(run_dir: Path) -> list[dict[str, Any]]:
+    """The decisions a run logged (``events.jsonl``), in order; none when it has no log."""
+    path = run_dir / "events.jsonl"
+    if not path.exists():
+        return []
+    return [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines() if line]

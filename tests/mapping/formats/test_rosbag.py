@@ -9,13 +9,12 @@ from scipy.spatial.transform import Rotation
 from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.mapping.formats.rosbag import (
     BagScan,
-    BagTopics,
     PoseTrack,
     fuse_bag,
     read_bag_scans,
     read_label_names,
-    write_bag,
 )
+from seminspect.mapping.formats.rosbag_writer import BagTopics, write_bag
 from seminspect.mapping.formats.semantickitti import (
     label_table,
     read_calib,

@@ -15,7 +15,8 @@ from seminspect.missions.xflie.config import make_config, resolve
 from seminspect.missions.xflie.layout import read_metrics_document
 from seminspect.missions.xflie.run import run_mission
 from seminspect.missions.xflie.team_run import build_team
-from seminspect.report.run_pictures import load_events, render_run
+from seminspect.report.run_pictures import render_run
+from seminspect.runs.directory import load_events
 from seminspect.runs.trajectory import load_robot_trajectories
 from seminspect.worlds import open_world
 

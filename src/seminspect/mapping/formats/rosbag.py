@@ -1,4 +1,5 @@
-"""ROS bags in and out: labelled ``PointCloud2`` scans with ``Odometry``, through ``rosbags``.
+"""Reading ROS bags: labelled ``PointCloud2`` scans with ``Odometry``, through ``rosbags``
+(:mod:`.rosbag_writer` writes them).
 
 ``rosbags`` is pure Python and reads ROS1 ``.bag`` files and ROS2 bag directories (sqlite3 or
 mcap) without a ROS installation. What seminspect reads from a bag:
@@ -14,8 +15,9 @@ mcap) without a ROS installation. What seminspect reads from a bag:
   odometry's frame is in the map already, one in another frame needs a ``/tf_static`` chain
   from the child frame (``/tf`` is not read);
 * optionally a ``std_msgs/String`` topic :data:`LABEL_NAMES_TOPIC` holding a JSON object of
-  label id -> class name, which :func:`write_bag` adds so the bag names its own labels; a bag
-  without it is named by SemanticKITTI's label table, with a :class:`BagWarning`.
+  label id -> class name, which :func:`~seminspect.mapping.formats.rosbag_writer.write_bag`
+  adds so the bag names its own labels; a bag without it is named by SemanticKITTI's label
+  table, with a :class:`BagWarning`.
 
 Fusing the scans into 001's metric-semantic cloud (Sec III-A.3) is
 :func:`seminspect.mapping.ingest.integrate_labelled_scan`, one view per cloud.
@@ -25,7 +27,6 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 import warnings
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
@@ -40,7 +41,7 @@ from scipy.spatial.transform import Rotation, Slerp
 from seminspect.core.errors import FileFormatError, InvalidInputError, SeminspectError
 from seminspect.mapping.formats.semantickitti import label_table
 from seminspect.mapping.ingest import integrate_labelled_scan
-from seminspect.mapping.semantic_cloud import SemanticCloud, as_transform
+from seminspect.mapping.semantic_cloud import SemanticCloud
 from seminspect.perception.encoders import Encoder
 
 #: A cloud may be this far outside the odometry's span and still take its end pose.
@@ -52,7 +53,6 @@ STRING_TYPE = "std_msgs/msg/String"
 TF_STATIC_TOPIC = "/tf_static"
 #: sensor_msgs/PointField datatypes as numpy types.
 _FIELD_TYPES = {1: "i1", 2: "u1", 3: "i2", 4: "u2", 5: "i4", 6: "u4", 7: "f4", 8: "f8"}
-_LABEL_FIELD_TYPE = 6  # uint32, as SemanticKITTI stores labels
 #: Odometry messages at one stamp whose poses differ less than this (m, rad) are one message.
 _SAME_POSE = 1e-9
 
@@ -78,7 +78,8 @@ class BagScan:
     pose: NDArray[np.float64]
 
 
-def _typestore():
+def ros_typestore() -> Any:
+    """The ROS2 Humble message definitions (rosbags' typestore); a clear error without rosbags."""
     try:
         from rosbags.typesys import Stores, get_typestore  # noqa: PLC0415 - optional dependency
     except ImportError:
@@ -91,7 +92,7 @@ def _typestore():
 @contextmanager
 def _opened(path: str | os.PathLike[str]) -> Iterator[Any]:
     """An open ``AnyReader`` over one ROS1 or ROS2 bag; unreadable bags are a FileFormatError."""
-    typestore = _typestore()
+    typestore = ros_typestore()
     from rosbags.highlevel import AnyReader  # noqa: PLC0415 - optional dependency
 
     source = Path(path)
@@ -381,120 +382,3 @@ def fuse_bag(
     if count == 0:
         raise InvalidInputError("the cloud topic has no messages")
     return cloud
-
-
-# --- writing -----------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class BagTopics:
-    """Topic and frame names of a bag :func:`write_bag` makes."""
-
-    cloud: str = "/points"
-    odometry: str = "/odom"
-    map_frame: str = "map"
-    sensor_frame: str = "lidar"
-
-
-def write_bag(
-    path: str | os.PathLike[str],
-    scans: Iterable[BagScan],
-    label_names: Mapping[int, str] | None = None,
-    topics: BagTopics = BagTopics(),
-) -> Path:
-    """Write scans as ``PointCloud2`` (x, y, z float32, label uint32) plus ``Odometry``.
-
-    The bag is a ROS2 bag directory (sqlite3, ROS2 Humble message definitions); ROS1 bags are
-    read, not written. It appears only when complete: written beside, then renamed into place.
-    """
-    target = Path(path)
-    if target.exists():
-        raise InvalidInputError(f"{target} exists; choose a new bag name")
-    typestore = _typestore()
-    from rosbags.rosbag2 import Writer  # noqa: PLC0415 - optional dependency
-
-    partial = target.with_name(f".{target.name}.partial")
-    if partial.exists():
-        _remove(partial)
-    try:
-        with Writer(partial, version=9) as writer:
-            _write_messages(writer, typestore, scans, label_names, topics)
-        partial.rename(target)
-    except BaseException:
-        _remove(partial)
-        raise
-    return target
-
-
-def _remove(path: Path) -> None:
-    if path.is_dir():
-        shutil.rmtree(path)
-    else:
-        path.unlink(missing_ok=True)
-
-
-def _write_messages(writer, typestore, scans, label_names, topics: BagTopics) -> None:
-    serialize = typestore.serialize_cdr
-    types = typestore.types
-    clouds = writer.add_connection(topics.cloud, CLOUD_TYPE, typestore=typestore)
-    odometry = writer.add_connection(topics.odometry, ODOMETRY_TYPE, typestore=typestore)
-    names_written = label_names is None
-    for scan in scans:
-        header = _header(types, scan.stamp_ns, topics.sensor_frame)
-        if not names_written:
-            connection = writer.add_connection(LABEL_NAMES_TOPIC, STRING_TYPE, typestore=typestore)
-            text = json.dumps({str(k): v for k, v in sorted(label_names.items())})
-            writer.write(
-                connection, scan.stamp_ns, serialize(types[STRING_TYPE](text), STRING_TYPE)
-            )
-            names_written = True
-        odom = _odometry_message(types, scan, topics)
-        writer.write(odometry, scan.stamp_ns, serialize(odom, ODOMETRY_TYPE))
-        writer.write(
-            clouds, scan.stamp_ns, serialize(_cloud_message(types, header, scan), CLOUD_TYPE)
-        )
-
-
-def _header(types, stamp_ns: int, frame: str):
-    stamp = types["builtin_interfaces/msg/Time"](
-        sec=stamp_ns // 1_000_000_000, nanosec=stamp_ns % 1_000_000_000
-    )
-    return types["std_msgs/msg/Header"](stamp=stamp, frame_id=frame)
-
-
-def _cloud_message(types, header, scan: BagScan):
-    field = types["sensor_msgs/msg/PointField"]
-    rows = np.zeros(
-        len(scan.points), dtype=[("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("label", "<u4")]
-    )
-    for axis, name in enumerate("xyz"):
-        rows[name] = scan.points[:, axis]
-    if scan.labels is not None:
-        rows["label"] = scan.labels
-    fields = [field(name=n, offset=4 * i, datatype=7, count=1) for i, n in enumerate("xyz")]
-    fields.append(field(name="label", offset=12, datatype=_LABEL_FIELD_TYPE, count=1))
-    return types[CLOUD_TYPE](
-        header=header, height=1, width=len(rows), fields=fields, is_bigendian=False,
-        point_step=16, row_step=16 * len(rows), data=rows.view(np.uint8).reshape(-1),
-        is_dense=True,
-    )  # fmt: skip
-
-
-def _odometry_message(types, scan: BagScan, topics: BagTopics):
-    pose = as_transform(scan.pose, "scan pose")
-    x, y, z, w = Rotation.from_matrix(pose[:3, :3]).as_quat()
-    geometry = types["geometry_msgs/msg/Pose"](
-        position=types["geometry_msgs/msg/Point"](*pose[:3, 3].tolist()),
-        orientation=types["geometry_msgs/msg/Quaternion"](x=x, y=y, z=z, w=w),
-    )
-    covariance = np.zeros(36)
-    twist = types["geometry_msgs/msg/Twist"](
-        linear=types["geometry_msgs/msg/Vector3"](0.0, 0.0, 0.0),
-        angular=types["geometry_msgs/msg/Vector3"](0.0, 0.0, 0.0),
-    )
-    return types[ODOMETRY_TYPE](
-        header=_header(types, scan.stamp_ns, topics.map_frame),
-        child_frame_id=topics.sensor_frame,
-        pose=types["geometry_msgs/msg/PoseWithCovariance"](pose=geometry, covariance=covariance),
-        twist=types["geometry_msgs/msg/TwistWithCovariance"](twist=twist, covariance=covariance),
-    )

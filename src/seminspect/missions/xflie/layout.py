@@ -12,6 +12,7 @@ Layout (beside the common files of :mod:`seminspect.runs.directory`)::
       metrics.json      Table 3 and Table 6 figures, mission time, distance (METRICS_FORMAT)
       summary.md        the same, for people
       images/           the view images the graph refers to
+      run.mcap          with ``--record-mcap``: the run as ROS 2 messages (:mod:`.recording`)
 """
 
 from __future__ import annotations
@@ -32,12 +33,13 @@ from seminspect.worlds import World, open_world
 #: The tag of an xFLIE run's ``metrics.json`` (the name every mission has written since v1).
 METRICS_FORMAT = "seminspect.run-metrics"
 MAP_FILE = "map.npz"
+MCAP_FILE = "run.mcap"
 #: The files a finished run holds; a completed run has every one of them.
 OUTPUT_FILES = (
     "graph.json", MAP_FILE, "trajectory.csv", "events.jsonl", "summary.md", METRICS_FILE,
 )  # fmt: skip
 XFLIE_LAYOUT = RunLayout(
-    files=frozenset({"graph.json", MAP_FILE}),
+    files=frozenset({"graph.json", MAP_FILE, MCAP_FILE}),
     folders={
         "snapshots": re.compile(r"graph-[\d.]+s\.json"),
         "robots": re.compile(r"[a-z]+-trajectory\.csv"),

@@ -25,7 +25,8 @@ from scipy.spatial.transform import Rotation
 
 from seminspect.core.errors import InvalidInputError
 from seminspect.geometry.transforms import yaw_rotation
-from seminspect.mapping.formats.rosbag import BagScan, write_bag
+from seminspect.mapping.formats.rosbag import BagScan
+from seminspect.mapping.formats.rosbag_writer import write_bag
 from seminspect.missions.xflie.layout import load_run_world
 from seminspect.runs.trajectory import load_trajectory
 from seminspect.sensors.lidar import Lidar
