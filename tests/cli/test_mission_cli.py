@@ -1,4 +1,5 @@
 import json
+import socket
 from pathlib import Path
 
 import pytest
@@ -154,3 +155,39 @@ def test_a_failed_recording_is_one_line_and_leaves_no_file(capsys, tmp_path, mon
     assert code == 1 and "completed" in text and f"results: {out}" in text
     assert err.strip() == "error: camera unplugged"
     assert not [p for p in out.iterdir() if "mcap" in p.name]
+
+
+def test_view_on_a_port_in_use_is_one_line_before_the_mission(capsys, tmp_path) -> None:
+    out = tmp_path / "run"
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        code, _, err = run(capsys, "mission", "--view", "--view-port", str(port), "--out", str(out))
+    assert code != 0
+    assert f"cannot serve the live view on 127.0.0.1:{port}" in err and "Traceback" not in err
+    assert not out.exists()
+
+
+def test_a_team_cannot_be_watched(capsys, tmp_path) -> None:
+    out = tmp_path / "team"
+    code, _, err = run(
+        capsys, "mission", "--robots", "explorer,inspector", "--view", "--view-port", "0",
+        "--out", str(out),
+    )  # fmt: skip
+    assert code != 0 and "a team cannot be watched yet" in err
+    assert not out.exists()
+
+
+@pytest.mark.slow
+def test_view_prints_its_address_and_changes_no_output(capsys, tmp_path) -> None:
+    args = ("--world", "campus", "--scenario", "small", "--budget", "60", "--no-pictures")
+    code, _, _ = run(capsys, "mission", *args, "--out", str(tmp_path / "plain"))
+    assert code == 0
+    code, text, err = run(
+        capsys, "mission", *args, "--view", "--view-port", "0", "--out", str(tmp_path / "seen")
+    )
+    assert code == 0 and "completed" in text
+    assert "live view at http://127.0.0.1:" in err
+    for name in ("graph.json", "trajectory.csv", "events.jsonl"):
+        assert (tmp_path / "seen" / name).read_bytes() == (tmp_path / "plain" / name).read_bytes()

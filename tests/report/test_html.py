@@ -4,10 +4,12 @@ real (headless) browser when one is installed."""
 from __future__ import annotations
 
 import json
-import os
 import shutil
 from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -18,25 +20,8 @@ from seminspect.graphs.terrain.prompting import TaskPrompts
 from seminspect.graphs.terrain.scene_graph import build_terrain_graph
 from seminspect.mapping.formats.pointfiles import PointData
 from seminspect.mapping.ingest import cloud_from_point_data
+from seminspect.report.browser import CHROMIUM_HINT, find_chromium, open_page
 from seminspect.report.html import REPORT_FILE, THUMBNAIL_WIDTH, run_kind, write_report
-
-CHROMIUM_ARGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--no-first-run",
-]
-
-
-def _chromium() -> str | None:
-    """A Chromium binary: $SEMINSPECT_CHROMIUM, Debian's package, or one on PATH."""
-    for candidate in (os.environ.get("SEMINSPECT_CHROMIUM"), "/usr/bin/chromium"):
-        if candidate and Path(candidate).is_file():
-            return candidate
-    return shutil.which("chromium") or shutil.which("chromium-browser")
 
 
 def _expected_mission_layers(run_dir: Path) -> dict[str, int]:
@@ -173,54 +158,119 @@ _HOVER_FIRST_IMAGE = """() => {
 }"""
 
 
+@dataclass
+class Rendered:
+    """What a page showed in the browser."""
+
+    #: Layer traces of the figure as the page's plotly sees them (``meta``, points drawn).
+    traces: list[dict]
+    #: The hover panel after hovering a node with an image (None when not asked for).
+    hover: str | None
+    #: Every console error.
+    errors: list[str]
+    #: What ``then(page)`` returned.
+    then: Any = None
+
+
 def _open_in_browser(
-    report: Path, screenshot: Path, figure: str = "scene", hover: bool = True
-) -> tuple[list[dict], str | None, list[str]]:
-    """Layer traces of ``figure-<figure>`` as the page's plotly sees them, the hover panel
-    after hovering a node with an image (``hover``), every console error."""
-    chromium = _chromium()
-    if chromium is None:
-        pytest.skip("no Chromium found (apt-get install chromium, or set $SEMINSPECT_CHROMIUM)")
-    sync_api = pytest.importorskip("playwright.sync_api", reason="playwright is not installed")
-    errors: list[str] = []
-    with sync_api.sync_playwright() as driver:
-        browser = driver.chromium.launch(executable_path=chromium, args=CHROMIUM_ARGS)
-        try:
-            page = browser.new_page(viewport={"width": 1400, "height": 1000})
-            page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
-            page.on("pageerror", lambda exc: errors.append(str(exc)))
-            page.goto(report.as_uri())
-            # a 3D figure has its scene laid out, a 2D one its x axis
-            page.wait_for_function(
-                "id => (l => l?.scene !== undefined || l?.xaxis !== undefined)"
-                "(document.getElementById(id)?._fullLayout)",
-                arg=f"figure-{figure}",
-                timeout=60_000,
-            )
-            # gd.data keeps the figure's (binary) input; _fullData has what plotly drew
-            traces = page.evaluate(
-                "id => (gd => gd.data.map((t, i) => ({meta: t.meta ?? null, "
-                "points: gd._fullData[i]._length})))(document.getElementById(id))",
-                f"figure-{figure}",
-            )
-            panel = page.evaluate(_HOVER_FIRST_IMAGE) if hover else None
-            page.screenshot(path=str(screenshot))
-        finally:
-            browser.close()
-    return traces, panel, errors
+    report: Path,
+    screenshot: Path,
+    figure: str = "scene",
+    hover: bool = True,
+    then: Callable[[Any], Any] | None = None,
+) -> Rendered:
+    """The page in headless Chromium (:func:`seminspect.report.browser.open_page`): the traces
+    of ``figure-<figure>``, the hover panel (``hover``), then whatever ``then(page)`` finds."""
+    if find_chromium() is None:
+        pytest.skip(f"no Chromium found ({CHROMIUM_HINT})")
+    pytest.importorskip("playwright.sync_api", reason="playwright is not installed")
+    with open_page(report.as_uri()) as (page, errors):
+        # gd.data keeps the figure's (binary) input; _fullData has what plotly drew
+        traces = page.evaluate(
+            "id => (gd => gd.data.map((t, i) => ({meta: t.meta ?? null, "
+            "points: gd._fullData[i]._length})))(document.getElementById(id))",
+            f"figure-{figure}",
+        )
+        panel = page.evaluate(_HOVER_FIRST_IMAGE) if hover else None
+        page.screenshot(path=str(screenshot))
+        found = then(page) if then is not None else None
+    return Rendered(traces, panel, errors, found)
+
+
+#: Move the playback slider to t as a reader's drag would (an ``input`` event), wait until the
+#: page has redrawn, and read back what the playback figure drew.
+_MOVE_SLIDER = """async (t) => {
+  const slider = document.getElementById('playback-time');
+  slider.value = t;
+  slider.dispatchEvent(new Event('input'));
+  const clock = document.getElementById('playback-clock');
+  while (clock.textContent !== 't = ' + t.toFixed(1) + ' s') {
+    await new Promise((done) => requestAnimationFrame(done));
+  }
+  const gd = document.getElementById('figure-playback');
+  const drawn = {};
+  gd.data.forEach((trace, i) => { drawn[trace.meta?.playback] = gd._fullData[i]._length; });
+  const robot = gd.data.find((trace) => trace.meta?.playback === 'robot');
+  const panel = document.getElementById('playback-view');
+  return {drawn, robot: [robot.x[0], robot.y[0]], view: panel.querySelector('img')?.alt ?? null,
+          caption: panel.textContent};
+}"""
+
+
+def _replay(times: list[float]) -> Callable[[Any], list[dict]]:
+    """The slider moved to each time, then Play and Pause pressed: what was drawn at each."""
+
+    def replay(page: Any) -> list[dict]:
+        states = [page.evaluate(_MOVE_SLIDER, t) for t in times]
+        page.click("#playback-play")
+        page.wait_for_function(
+            "t => document.getElementById('playback-time').valueAsNumber > t", arg=times[-1]
+        )
+        page.click("#playback-play")
+        states.append({"button": page.text_content("#playback-play")})
+        return states
+
+    return replay
 
 
 @pytest.mark.slow
 def test_mission_report_renders_in_a_browser(
     mission_report: Path, small_mission_dir: Path, tmp_path: Path
 ) -> None:
+    from seminspect.report.html_playback import mission_playback
+    from seminspect.runs.directory import load_events
+    from seminspect.runs.trajectory import load_trajectory
+
+    graph = load_graph(small_mission_dir / "graph.json")
+    images = {image for n in graph.nodes() if (image := getattr(n, "image", None))}
+    trajectory = load_trajectory(small_mission_dir)
+    playback = mission_playback(graph, load_events(small_mission_dir), trajectory, images)
+    times = [0.0, round(playback.end_s / 2, 1)]
     screenshot = tmp_path / "report.png"
-    traces, hover, errors = _open_in_browser(mission_report, screenshot)
-    assert errors == []
+    rendered = _open_in_browser(mission_report, screenshot, then=_replay(times))
+    assert rendered.errors == []
+    hover = rendered.hover
     assert hover is not None and "score" in hover and 'src="data:image/jpeg;base64,' in hover
-    rendered = {layer: t["points"] for layer, t in _by_layer(traces).items()}
-    assert rendered == _expected_mission_layers(small_mission_dir)
+    drawn = {layer: t["points"] for layer, t in _by_layer(rendered.traces).items()}
+    assert drawn == _expected_mission_layers(small_mission_dir)
     assert screenshot.stat().st_size > 20_000
+    # the playback: at each time the nodes that stood then, the robot where it was, its view
+    layer_of = {n.id: n.layer.value.capitalize() for n in graph.nodes() if n.id != "robot"}
+    *states, after_play = rendered.then
+    for t, state in zip(times, states, strict=True):
+        standing = Counter(layer_of[node] for node in playback.nodes_at(t))
+        assert {layer: state["drawn"][layer] for layer in drawn} == {
+            layer: standing.get(layer, 0) for layer in drawn
+        }
+        pose = playback.pose_at(t)
+        assert pose is not None and state["robot"] == pytest.approx(pose[:2], abs=1e-3)
+        assert state["view"] == playback.view_at(t)
+    start, middle = states
+    assert sum(start["drawn"][layer] for layer in drawn) == 0
+    assert "No inspection view yet" in start["caption"]
+    assert 0 < middle["drawn"]["Pose"] < drawn["Pose"]
+    assert middle["robot"] != start["robot"] and "latest inspection view" in middle["caption"]
+    assert after_play == {"button": "Play"}  # paused again
 
 
 def _by_layer(traces: list[dict]) -> dict[str, dict]:
@@ -229,9 +279,9 @@ def _by_layer(traces: list[dict]) -> dict[str, dict]:
 
 @pytest.mark.slow
 def test_terrain_report_renders_in_a_browser(terrain_report: Path, tmp_path: Path) -> None:
-    traces, _, errors = _open_in_browser(terrain_report, tmp_path / "terrain.png")
-    assert errors == []
-    layers = _by_layer(traces)
+    rendered = _open_in_browser(terrain_report, tmp_path / "terrain.png")
+    assert rendered.errors == []
+    layers = _by_layer(rendered.traces)
     assert set(layers) == {"Points", "Objects", "Places", "Regions", "Map"}
     assert all(t["points"] == t["meta"]["nodes"] for t in layers.values())
 
@@ -373,9 +423,9 @@ def test_run_kinds_are_told_apart_by_their_files(
 def test_routine_report_renders_in_a_browser(
     routine_report: Path, routine_run: Path, tmp_path: Path
 ) -> None:
-    traces, _, errors = _open_in_browser(routine_report, tmp_path / "routine.png", hover=False)
-    assert errors == []
-    layers = _by_layer(traces)
+    rendered = _open_in_browser(routine_report, tmp_path / "routine.png", hover=False)
+    assert rendered.errors == []
+    layers = _by_layer(rendered.traces)
     expected = _routine_counts(routine_run)
     assert {k: layers[k]["points"] for k in expected} == expected
 
@@ -383,8 +433,8 @@ def test_routine_report_renders_in_a_browser(
 @pytest.mark.slow
 def test_rl_report_renders_in_a_browser(rl_eval_dir: Path, tmp_path: Path) -> None:
     report = write_report(rl_eval_dir)
-    traces, _, errors = _open_in_browser(report, tmp_path / "rl.png", "coverage", hover=False)
-    assert errors == []
-    layers = _by_layer(traces)
+    rendered = _open_in_browser(report, tmp_path / "rl.png", "coverage", hover=False)
+    assert rendered.errors == []
+    layers = _by_layer(rendered.traces)
     assert set(layers) == {"0 obstacles", "4 obstacles"}
     assert all(t["points"] == t["meta"]["nodes"] for t in layers.values())

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import signal
 from enum import Enum
 from pathlib import Path
@@ -91,6 +92,15 @@ _RECORD_MCAP_OPTION = typer.Option(
     help="When the mission ends, write run.mcap into the run directory: its poses, LiDAR, "
     "camera, 3DLSG and events as ROS 2 messages, for Foxglove (File > Open local file).",
 )
+_VIEW_OPTION = typer.Option(
+    False,
+    "--view",
+    help="Watch the mission live in a browser: a page on localhost (its address is printed) "
+    "with the robot's path, its camera and detections, the map and the 3DLSG as they grow.",
+)
+_VIEW_PORT_OPTION = typer.Option(
+    8765, "--view-port", help="Port of --view on localhost (0: any free one).", min=0, max=65535
+)
 _FEATURES_OPTION = typer.Option(
     None,
     "--features",
@@ -123,6 +133,8 @@ def app(
     record_mcap: bool = _RECORD_MCAP_OPTION,
     robots: str | None = _ROBOTS_OPTION,
     features: str | None = _FEATURES_OPTION,
+    view: bool = _VIEW_OPTION,
+    view_port: int = _VIEW_PORT_OPTION,
 ) -> None:
     """Explore a site, inspect every target level by level and build its 3DLSG (paper 000).
 
@@ -149,7 +161,8 @@ def app(
         )  # fmt: skip
         if out is not None:
             writable_directory(out)
-    result = _run_with_progress(config, out, query)
+    with _live_view(view_port) if view else contextlib.nullcontext() as server:
+        result = _run_with_progress(config, out, query, server)
     if pictures and result.stop_signal != signal.SIGTERM:  # SIGTERM asks to stop now
         _draw_pictures(result.run_dir)
     if bag is not None and result.state == "completed":
@@ -207,10 +220,24 @@ def _resumed(ctx: typer.Context, run_dir: Path):
     return config, run_dir
 
 
-def _run_with_progress(config, out: Path | None, queries: list[str]):
+def _live_view(port: int):
+    """The live view's server, its address printed (a port in use: one clear line)."""
+    from seminspect.report.live_mission import live_page
+    from seminspect.report.live_server import LiveServer
+
+    server = LiveServer(live_page("seminspect mission (live)"), port)
+    err_console.print(f"live view at {server.url} (open it in a browser)", highlight=False)
+    return server
+
+
+def _run_with_progress(config, out: Path | None, queries: list[str], server=None):
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
+    from seminspect.missions.xflie.live import LiveWatch
     from seminspect.missions.xflie.run import run_mission
+    from seminspect.report.live_mission import MissionFeed
+
+    watch = None if server is None else LiveWatch(MissionFeed(server))
 
     columns = (
         TextColumn("[bold]{task.description}"),
@@ -234,7 +261,7 @@ def _run_with_progress(config, out: Path | None, queries: list[str]):
                 inspected=progress.inspected,
             )
 
-        return run_mission(config, out, queries=queries, progress=show)
+        return run_mission(config, out, queries=queries, progress=show, watch=watch)
 
 
 def _draw_pictures(run_dir: Path) -> None:

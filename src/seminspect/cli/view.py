@@ -3,7 +3,8 @@
 viser (spark-dsg's live viewer; 1.1.1 when this was written) needs rich < 15, which conflicts
 with the rich 15 seminspect's environment carries, so the viewer is the run's ``report.html``
 (plotly, turnable and queryable in 3D) served by the standard library's HTTP server on
-127.0.0.1 only.
+127.0.0.1 only. ``--screenshot FILE`` instead draws the page in headless Chromium and writes
+its picture (:mod:`seminspect.report.browser`), for machines without a display and for CI.
 """
 
 from __future__ import annotations
@@ -41,8 +42,16 @@ def app(
     rebuild: bool = typer.Option(
         False, "--rebuild", help="Redraw report.html even if the run already has one."
     ),
+    screenshot: Path | None = typer.Option(
+        None,
+        "--screenshot",
+        help="Write a PNG of the whole page, drawn in headless Chromium, to this file instead "
+        "of serving it (needs playwright: pip install 'seminspect[view]', and a Chromium).",
+        metavar="FILE",
+    ),
 ) -> None:
-    """Serve a run's report.html on localhost and open it (Ctrl-C stops the server).
+    """Serve a run's report.html on localhost and open it (Ctrl-C stops the server), or
+    with --screenshot write a picture of it and exit.
 
     report.html is written first when the run has none (runs made with --no-pictures, or
     before their program wrote one).
@@ -54,9 +63,14 @@ def app(
 
     if not run_dir.is_dir():
         raise InvalidInputError(f"{run_dir} is not a directory")
+    if screenshot is not None:
+        _check_screenshot_file(screenshot)
     if rebuild or not (run_dir / REPORT_FILE).is_file():
         with console.status("drawing report.html"):
             write_report(run_dir)
+    if screenshot is not None:
+        _write_screenshot(run_dir / REPORT_FILE, screenshot)
+        return
     try:
         server = make_server(run_dir.resolve(), port)
     except OSError as exc:
@@ -70,3 +84,31 @@ def app(
             server.serve_forever()
         except KeyboardInterrupt:
             console.print("stopped")
+
+
+def _check_screenshot_file(file: Path) -> None:
+    """Refuse, before any drawing, a picture that could not be written or has no browser."""
+    from seminspect.core.errors import InvalidInputError
+    from seminspect.report.browser import playwright_api, require_chromium
+
+    if file.suffix.lower() != ".png":
+        raise InvalidInputError(f"--screenshot {file}: the picture is a PNG; name it *.png")
+    if not file.parent.is_dir():
+        raise InvalidInputError(f"--screenshot {file}: folder {file.parent} does not exist")
+    if file.is_dir():
+        raise InvalidInputError(f"--screenshot {file} is a directory")
+    playwright_api()
+    require_chromium()
+
+
+def _write_screenshot(report: Path, file: Path) -> None:
+    """The picture, and a warning line for each error the page logged (it may show less)."""
+    import warnings
+
+    from seminspect.report.browser import screenshot
+
+    with console.status("drawing report.html in headless Chromium"):
+        errors = screenshot(report, file)
+    for error in errors:
+        warnings.warn(f"{report}: the page logged an error: {error}", stacklevel=1)
+    console.print(f"wrote {file}", highlight=False, soft_wrap=True)

@@ -2,7 +2,8 @@
 
 The 3DLSG's Feature, Pose, Level and Target layers are stacked above the world's footprints
 (000 Figs 2 and 12, the heights of ``graph.png``); hovering a node shows its name, label, score
-and, where it has one, its view image.
+and, where it has one, its view image. Below the scene, a time slider plays the mission back
+(:mod:`~seminspect.report.html_playback`).
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from numpy.typing import NDArray
 from seminspect.core.errors import FileFormatError
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.graphs.lsg.io import load_graph
-from seminspect.graphs.lsg.model import EdgeKind, FeatureNode, Layer, Node, RobotNode, TargetNode
+from seminspect.graphs.lsg.model import EdgeKind, FeatureNode, Node, RobotNode, TargetNode
 from seminspect.missions.xflie.layout import load_run_world, read_metrics_document
 from seminspect.report.html_page import (
     REPORT_FILE,
@@ -32,18 +33,12 @@ from seminspect.report.html_page import (
     thumbnails,
     write_page,
 )
-from seminspect.report.lsg import LAYER_ORDER, layer_heights, lifted_position
+from seminspect.report.html_playback import mission_playback, playback_section
+from seminspect.report.lsg import LAYER_COLOURS, LAYER_ORDER, layer_heights, lifted_position
 from seminspect.report.run_pictures import utility_series
 from seminspect.runs.directory import load_events
 from seminspect.runs.trajectory import load_trajectory
 from seminspect.worlds import World
-
-_LAYER_COLOURS = {
-    Layer.FEATURE: "#9467bd",
-    Layer.POSE: "#ff7f0e",
-    Layer.LEVEL: "#2ca02c",
-    Layer.TARGET: "#d62728",
-}
 
 
 def write_mission_report(run_dir: str | os.PathLike[str], world: World | None = None) -> Path:
@@ -53,12 +48,15 @@ def write_mission_report(run_dir: str | os.PathLike[str], world: World | None = 
     graph = load_graph(root / "graph.json")
     trajectory = load_trajectory(root)
     images = thumbnails(root, _image_refs(graph))
+    events = load_events(root)
     figures = [
         ("scene", mission_scene_figure(world, graph, trajectory)),
-        ("utility", utility_plot(load_events(root))),
+        ("utility", utility_plot(events)),
         ("path", path_plot(trajectory)),
     ]
-    sections = _metrics_sections(root)
+    playback = mission_playback(graph, events, trajectory, images)
+    replay = playback_section(playback, graph, footprint_trace(world))
+    sections = ([replay] if replay is not None else []) + _metrics_sections(root)
     title = f"Mission run {root.name}"
     return write_page(root / REPORT_FILE, title, figures, sections, images)
 
@@ -66,7 +64,7 @@ def write_mission_report(run_dir: str | os.PathLike[str], world: World | None = 
 def mission_scene_figure(world: World, graph: LayeredSemanticGraph, trajectory: NDArray):
     """The 3DLSG's layers stacked above the world's footprints, with the robot's path."""
     figure = go.Figure()
-    figure.add_trace(_footprint_trace(world))
+    figure.add_trace(footprint_trace(world))
     if len(trajectory):
         figure.add_trace(
             go.Scatter3d(
@@ -84,8 +82,8 @@ def mission_scene_figure(world: World, graph: LayeredSemanticGraph, trajectory: 
         xyz = np.array([lifted[n.id] for n in nodes]).reshape(-1, 3)
         figure.add_trace(
             node_trace(
-                xyz, layer.value.capitalize(), _LAYER_COLOURS[layer],
-                [_lsg_hover(n) for n in nodes], [getattr(n, "image", None) or "" for n in nodes],
+                xyz, layer.value.capitalize(), LAYER_COLOURS[layer],
+                [node_hover(n) for n in nodes], [getattr(n, "image", None) or "" for n in nodes],
             )
         )  # fmt: skip
     robot = lifted[graph.robot.id]
@@ -100,7 +98,8 @@ def mission_scene_figure(world: World, graph: LayeredSemanticGraph, trajectory: 
     return figure
 
 
-def _lsg_hover(node: Node) -> str:
+def node_hover(node: Node) -> str:
+    """A node's name, layer, label, score and status, as HTML for a hover box."""
     lines = [f"<b>{html.escape(node.id)}</b>", f"layer: {node.layer.value}"]
     if isinstance(node, TargetNode | FeatureNode):
         lines += [f"label: {html.escape(node.label)}", f"score: {node.score:.2f}"]
@@ -116,16 +115,23 @@ def _image_refs(graph: LayeredSemanticGraph) -> set[str]:
     return {image for n in graph.nodes() if (image := getattr(n, "image", None))}
 
 
-def _footprint_trace(world: World):
+def footprint_lines(world: World) -> dict[str, list[float | None]]:
+    """The outlines of the world's objects on the ground, one line with gaps (``None``)."""
     xs: list[float | None] = []
     ys: list[float | None] = []
     for info in world.instances.values():
         ring = np.asarray(info.footprint.exterior.coords)
         xs += [*ring[:, 0].tolist(), None]
         ys += [*ring[:, 1].tolist(), None]
+    return {"x": xs, "y": ys}
+
+
+def footprint_trace(world: World):
+    """The world's footprints on the ground as one 3D line trace."""
+    lines = footprint_lines(world)
     return go.Scatter3d(
-        x=xs, y=ys, z=[None if x is None else 0.0 for x in xs], mode="lines", name="world",
-        line={"color": "#999999", "width": 2}, hoverinfo="skip",
+        x=lines["x"], y=lines["y"], z=[None if x is None else 0.0 for x in lines["x"]],
+        mode="lines", name="world", line={"color": "#999999", "width": 2}, hoverinfo="skip",
     )  # fmt: skip
 
 

@@ -171,9 +171,9 @@ body { font-family: sans-serif; margin: 1em 2em; color: #222; }
 table { border-collapse: collapse; margin: 0.3em 0; }
 th, td { border: 1px solid #ccc; padding: 2px 8px; text-align: left; vertical-align: top; }
 th { background: #f3f3f3; font-weight: normal; }
-#scene-row { display: flex; gap: 1em; }
-#scene-row > div:first-child { flex: 1; min-width: 0; }
-#hover-panel { width: 200px; font-size: 0.85em; }
+#scene-row { display: flex; flex-direction: row-reverse; gap: 1em; }
+#scene-row > div:not(#hover-panel) { flex: 1; min-width: 0; }
+#hover-panel { width: 200px; flex: none; font-size: 0.85em; }
 """
 #: Added only to pages that show pictures, so the other pages stay as they were.
 _PICTURES_STYLE = """.pictures { display: flex; flex-wrap: wrap; gap: 1em; }
@@ -208,9 +208,11 @@ def write_page(
     if hover_hint is None:
         top, script = f"<div>{first}</div>", ""
     else:
+        # the panel comes first and is shown on the right (row-reverse): plotly sizes a figure
+        # when it draws it, so a panel parsed after the figure would end up beneath it
         top = (
-            f'<div id="scene-row"><div>{first}</div>\n'
-            f'<div id="hover-panel">{html.escape(hover_hint)}</div></div>'
+            f'<div id="scene-row"><div id="hover-panel">{html.escape(hover_hint)}</div>\n'
+            f"<div>{first}</div></div>"
         )
         # "</" cannot appear inside a script element; base64 and JSON escapes keep it out
         thumbnail_json = json.dumps(dict(thumbnails)).replace("</", "<\\/")

@@ -25,6 +25,13 @@ LAYER_STYLE = {
     Layer.TARGET: ("tab:red", 60, "Target"),
 }
 LAYER_ORDER = (Layer.FEATURE, Layer.POSE, Layer.LEVEL, Layer.TARGET)
+#: The same colours in hex, for the report's plotly figures (its scene and its playback).
+LAYER_COLOURS = {
+    Layer.FEATURE: "#9467bd",
+    Layer.POSE: "#ff7f0e",
+    Layer.LEVEL: "#2ca02c",
+    Layer.TARGET: "#d62728",
+}
 
 
 def layer_heights(graph: LayeredSemanticGraph, spacing: float | None = None) -> dict[Layer, float]:

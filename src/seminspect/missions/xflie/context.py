@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
+from typing import Protocol
 
 from seminspect.core.params import InspectionParams
 from seminspect.geometry.transforms import quat_from_yaw
@@ -22,6 +23,19 @@ from seminspect.sensors import Detection, Frame
 DEPTH_STRIDE = 8
 
 
+class MissionWatch(Protocol):
+    """Something that looks at a mission while it runs (the live view). It only reads what it
+    is shown, so a watched mission makes the same decisions as one nobody watches."""
+
+    def frame(self, frame: Frame) -> None:
+        """A camera frame, just put into the robot's map."""
+        ...
+
+    def detections(self, frame: Frame, detections: Sequence[Detection]) -> None:
+        """What the mission kept of a frame's detections."""
+        ...
+
+
 @dataclass
 class MissionContext:
     """The state the phases of one mission share.
@@ -31,6 +45,7 @@ class MissionContext:
         unreachable: targets given up on (not reached, or too few views to inspect).
         frames_seen: camera frames taken so far (they number the saved images).
         on_step: called when a phase has made progress worth showing.
+        watch: shown every frame and the detections kept of it (None: nobody watches).
     """
 
     config: ResolvedMissionConfig
@@ -44,6 +59,7 @@ class MissionContext:
     unreachable: set[str] = field(default_factory=set)
     frames_seen: int = 0
     on_step: Callable[[], None] = lambda: None
+    watch: MissionWatch | None = None
 
     @property
     def params(self) -> InspectionParams:
@@ -78,11 +94,16 @@ class MissionContext:
                 carving_spacing=self.config.map_carving_spacing,
             )
         self.frames_seen += 1
+        if self.watch is not None:
+            self.watch.frame(frame)
 
     def detect(self, frame: Frame, level: str, labels: Iterable[str]) -> list[Detection]:
         """Segmentations at or above the confidence threshold."""
         detections = self.platform.detect(frame, level, labels)
-        return [d for d in detections if d.score >= self.config.min_score]
+        kept = [d for d in detections if d.score >= self.config.min_score]
+        if self.watch is not None:
+            self.watch.detections(frame, kept)
+        return kept
 
     def view_pose(self, image: str | None) -> Observation:
         """The robot's current pose as a view-pose observation (eq 9)."""

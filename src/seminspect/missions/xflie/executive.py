@@ -98,6 +98,8 @@ class XFlie:
         self.progress = progress
         self.phase = "start"
         self.stop_reason = ""
+        #: The last target selection's winner and its eq (6) terms (None: none yet, or none left).
+        self.choice: UtilityTerms | None = None
         self.graph = (
             graph
             if graph is not None
@@ -191,6 +193,7 @@ class XFlie:
         targets given up on and those in ``taken`` (another robot's) are not candidates."""
         choice, terms = select_target(self.graph, exclude=self.unreachable.union(taken))
         self._log_utilities(choice, terms)
+        self.choice = choice
         return choice
 
     def pursue(self, target: TargetNode) -> bool:

@@ -14,6 +14,7 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Sequence
 
+from seminspect.core.errors import InvalidInputError
 from seminspect.core.interrupts import stop_on_signals
 from seminspect.missions.xflie import MissionProgress
 from seminspect.missions.xflie.build import build_mission, run_name
@@ -25,6 +26,7 @@ from seminspect.missions.xflie.config import (
 )
 from seminspect.missions.xflie.figures import mission_metrics
 from seminspect.missions.xflie.layout import OUTPUT_FILES, XFLIE_LAYOUT
+from seminspect.missions.xflie.live import LiveWatch
 from seminspect.missions.xflie.metrics import CpuMeter, MissionMetrics, QueryAnswer
 from seminspect.missions.xflie.outputs import MissionResult, save_outputs, write_graph_first
 from seminspect.missions.xflie.queries import answer_queries
@@ -44,14 +46,18 @@ def run_mission(
     queries: Sequence[str] = (),
     progress: Callable[[MissionProgress], None] | None = None,
     detector: Detector | None = None,
+    watch: LiveWatch | None = None,
 ) -> MissionResult:
     """Run a mission into ``out`` (default: a fresh directory under ``base``), every robot
-    seeing through ``detector`` (default: the simulator's labels with the fault model).
+    seeing through ``detector`` (default: the simulator's labels with the fault model), shown
+    live to ``watch`` when given (one robot only: a team is refused).
 
     The world is made first, so a bad world or scenario creates no directory. ``out`` is then
     claimed (see :meth:`RunDirectory.claimed`): a second run on it fails at once, and files of an
     earlier run in it are removed. Ctrl-C and SIGTERM end the mission as ``interrupted``.
     """
+    if watch is not None and config.robots:
+        raise InvalidInputError("the live view shows one robot; a team cannot be watched yet")
     world = open_world(config.world, default_scenario(config), seed=config.seed)
     config = resolve(config, world)
     with stop_on_signals():
@@ -63,7 +69,7 @@ def run_mission(
         with run.claimed(config.model_dump(mode="json")):
             if config.robots:
                 return run_team(run, config, world, queries, progress, detector=detector)
-            return _run(run, config, world, queries, progress, detector=detector)
+            return _run(run, config, world, queries, progress, detector=detector, watch=watch)
 
 
 def _run(
@@ -74,8 +80,11 @@ def _run(
     progress: Callable[[MissionProgress], None] | None,
     *,
     detector: Detector | None,
+    watch: LiveWatch | None,
 ) -> MissionResult:
     mission, world = build_mission(config, run, progress, world, detector=detector)
+    if watch is not None:
+        watch.attach(mission, world)
     warm_up()  # compile before the clock starts: a fresh install times plans, not numba
     cpu = CpuMeter()
     answers: list[QueryAnswer] = []
@@ -91,6 +100,8 @@ def _run(
         save_outputs(run, mission, metrics, answers)
 
     end = conduct_run(run, mission.execute, write_outputs, expected=OUTPUT_FILES, what="mission")
+    if watch is not None:
+        watch.publish(ended=end.state)
     return MissionResult(
         run.root, end.state, end.reason, metrics, mission, world, answers, end.signum
     )
