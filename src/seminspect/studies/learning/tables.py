@@ -47,6 +47,7 @@ NEEDS = {
         "v3-no-svs",
         "v3-no-gru",
         "v3-gru-512",
+        "v4-tune",
         "table1-orbit",
     ),
 }
