@@ -1,5 +1,7 @@
 """``seminspect rl``: evaluate and show baselines, and one-line errors."""
 
+import socket
+
 import pytest
 
 from cli_runner import run
@@ -132,3 +134,31 @@ def test_without_torch_the_learned_policy_says_how_to_get_it(capsys, tmp_path, m
     code, _, err = run(capsys, "rl", "eval", "--out", str(tmp_path / "x"))
     assert code == 1
     assert "pip install 'seminspect[rl]'" in err and "Traceback" not in err
+
+
+def test_show_view_on_a_port_in_use_is_one_line_before_the_episode(capsys, tmp_path):
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        code, _, err = run(
+            capsys, "rl", "show", "--policy", "random", "--view", "--view-port", str(port),
+            "--out", str(tmp_path / "show"),
+        )  # fmt: skip
+    assert code == 1 and f"cannot serve the live view on 127.0.0.1:{port}" in err
+    assert "Traceback" not in err and not (tmp_path / "show").exists()
+
+
+@pytest.mark.slow
+def test_show_view_flies_the_same_episode(capsys, tmp_path, monkeypatch):
+    monkeypatch.setattr("seminspect.cli._common.VIEW_WAIT_S", 0.1)
+    args = ("rl", "show", "--policy", "random", "--obstacles", "9", "--seed", "3")
+    code, plain, err = run(capsys, *args, "--out", str(tmp_path / "plain"))
+    assert code == 0, err
+    code, seen, err = run(
+        capsys, *args, "--view", "--view-port", "0", "--out", str(tmp_path / "seen")
+    )
+    assert code == 0, err
+    assert "live view at http://127.0.0.1:" in err
+    assert seen.splitlines()[0] == plain.splitlines()[0]  # the same coverage and ending
+    assert "crashed" in seen

@@ -1,5 +1,7 @@
 """``seminspect routine``: map, inspect with a recorded prior, and one-line errors."""
 
+import socket
+
 import pytest
 
 from cli_runner import run
@@ -125,3 +127,34 @@ def test_the_results_line_names_no_pictures_that_were_not_drawn(capsys, tmp_path
     assert code == 0, err
     line = next(line for line in out.splitlines() if "results: " in line)
     assert "summary.md, metrics.json" in line and "no pictures" in line and "*.png" not in line
+
+
+def test_view_with_compare_is_refused_in_one_line_before_any_work(capsys, tmp_path):
+    out = tmp_path / "run"
+    code, _, err = run(capsys, "routine", "inspect", "--compare", "--view", "--out", str(out))
+    assert code == 1 and "--view watches one run: leave out --compare" in err
+    assert len(err.strip().splitlines()) <= 2 and not out.exists()
+
+
+def test_view_on_a_port_in_use_is_one_line_before_the_run(capsys, tmp_path):
+    out = tmp_path / "run"
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        code, _, err = run(
+            capsys, "routine", "inspect", "--view", "--view-port", str(port), "--out", str(out)
+        )
+    assert code == 1 and f"cannot serve the live view on 127.0.0.1:{port}" in err
+    assert "Traceback" not in err and not out.exists()
+
+
+@pytest.mark.slow
+def test_view_prints_its_address_and_runs_when_nobody_opens_it(capsys, tmp_path, monkeypatch):
+    monkeypatch.setattr("seminspect.cli._common.VIEW_WAIT_S", 0.1)
+    code, out, err = run(
+        capsys, "routine", "inspect", "--scenario", "receding", "--seed", "1", "--length", "12",
+        "--no-pictures", "--view", "--view-port", "0", "--out", str(tmp_path / "run"),
+    )  # fmt: skip
+    assert code == 0, err
+    assert "live view at http://127.0.0.1:" in err and out.startswith("completed: ")

@@ -19,19 +19,14 @@ from seminspect.missions.xflie.config import make_config
 from seminspect.missions.xflie.live import LiveWatch
 from seminspect.missions.xflie.run import run_mission
 from seminspect.report.browser import find_chromium, open_page
-from seminspect.report.live_mission import (
-    MAX_MAP_POINTS,
-    TRACES,
-    MissionFeed,
-    camera_picture,
-    graph_traces,
-    live_page,
-    occupied_points,
-)
+from seminspect.report.live_common import MAX_MAP_POINTS, camera_picture, occupied_points
+from seminspect.report.live_mission import LAYERS as LAYER_TRACES
+from seminspect.report.live_mission import MissionFeed, graph_traces, live_page
 from seminspect.report.live_server import LiveServer
 from seminspect.sensors import CameraModel, Detection, Frame
 
 LAYERS = ("Feature", "Pose", "Level", "Target")
+assert LAYER_TRACES == LAYERS  # the page's trace names are the layers' own
 
 
 class _Server:
@@ -50,14 +45,15 @@ class _Server:
 
     def send(self, message: dict, event: str = "message") -> None:
         kept = self.sent if event == "message" else self.maps
+        assert event in {"message", "traces"}
         kept.append(json.loads(json.dumps(message, allow_nan=False)))
 
 
 def _frame(intensity: bool) -> Frame:
-    camera = CameraModel(width=64, height=48)
+    camera = CameraModel(width=320, height=240)
     shape = (camera.height, camera.width)
     depth = np.full(shape, np.inf, np.float32)
-    depth[10:30, 20:40] = 5.0
+    depth[50:150, 100:200] = 5.0
     return Frame(
         depth=depth,
         instance=np.zeros(shape, np.int32),
@@ -66,7 +62,7 @@ def _frame(intensity: bool) -> Frame:
         intensity=np.full(shape, 128, np.uint8) if intensity else None,
         face=np.full(shape, -1, np.int32),
         position=(0.0, 0.0, 1.0),
-        orientation=(1.0, 0.0, 0.0, 0.0),
+        orientation=(0.0, 0.0, 0.0, 1.0),
         stamp=0.0,
         camera=camera,
     )
@@ -74,8 +70,8 @@ def _frame(intensity: bool) -> Frame:
 
 def _box(shape: tuple[int, int]) -> Detection:
     mask = np.zeros(shape, bool)
-    mask[10:30, 20:40] = True
-    return Detection("car", mask, int(mask.sum()), 0.9, (20, 10, 40, 30), 1, "instance", 5.0)
+    mask[50:150, 100:200] = True
+    return Detection("car", mask, int(mask.sum()), 0.9, (100, 50, 200, 150), 1, "instance", 5.0)
 
 
 def _decoded(uri: str) -> np.ndarray:
@@ -92,7 +88,7 @@ def test_the_camera_picture_shows_the_frame_with_its_boxes(intensity: bool) -> N
     assert plain.shape == (360, 480, 3)  # scaled to the page's width
     changed = np.abs(boxed.astype(int) - plain.astype(int)).max(axis=2) > 60
     rows, cols = np.nonzero(changed)
-    # the box's outline (20..40 x 10..30 px of 64 x 48, scaled by 7.5) and its caption
+    # the box's outline (100..200 x 50..150 px of 320 x 240, scaled by 1.5) and its caption
     assert cols.min() >= 140 and cols.max() <= 310 and rows.max() <= 230
     assert changed[75:225, 148:152].mean() > 0.5  # its left edge
 
@@ -124,7 +120,8 @@ def test_graph_traces_hold_every_node_and_edge(small_mission_dir: Path) -> None:
     assert all(len(traces[layer]["text"]) == counts[layer] for layer in LAYERS)
     edges = len(traces["spatial edges"]["x"]) + len(traces["symbolic edges"]["x"])
     assert edges == 3 * sum(1 for _ in graph.edges())
-    assert set(traces) | {"world", "map", "path", "robot"} == set(TRACES)
+    assert all(traces[layer]["name"] == f"{layer} ({counts[layer]})" for layer in LAYERS)
+    assert set(traces) == {*LAYERS, "spatial edges", "symbolic edges"}
 
 
 @pytest.fixture(scope="module")
@@ -138,10 +135,11 @@ def feed_messages(tmp_path_factory: pytest.TempPathFactory) -> tuple[_Server, Pa
 
 def test_messages_are_the_mission_as_it_stood(feed_messages) -> None:
     server, out = feed_messages
-    assert server.scene is not None and len(server.scene["world"]["x"]) > 10
+    assert server.scene is not None and len(server.scene["traces"]["world"]["x"]) > 10
     first, last = server.sent[0], server.sent[-1]
     assert first["t"] < last["t"] and first["final"] is None
-    assert last["final"] == "completed"
+    assert last["final"] == "mission completed"
+    assert dict(map(tuple, last["status"]))["mission"] == "completed"
     assert last["pose"][:3] == pytest.approx(
         [last["traces"]["path"][axis][-1] for axis in "xyz"], abs=0.01
     )
@@ -152,18 +150,28 @@ def test_messages_are_the_mission_as_it_stood(feed_messages) -> None:
     }
     # the map goes on its own, at most every MAP_PERIOD_S, and once more at the end
     assert 1 < len(server.maps) < len(server.sent) / 2
-    assert 0 < len(server.maps[-1]["x"]) <= MAX_MAP_POINTS
-    assert any(m["detections"] for m in server.sent)
-    assert all(m["image"] is None or m["image"].startswith("data:image/jpeg") for m in server.sent)
-    assert any(m["target"] is not None for m in server.sent)
-
-
-def _drawn(page) -> dict[str, int]:
-    """Points plotly drew in each trace of the live scene."""
-    return page.evaluate(
-        "() => Object.fromEntries(document.getElementById('live-scene')._fullData"
-        ".map((t) => [t.meta.trace, t._length ?? 0]))"
+    assert 0 < len(server.maps[-1]["traces"]["map"]["x"]) <= MAX_MAP_POINTS
+    with_detections = [m for m in server.sent if m["detections"]]
+    assert with_detections and all(
+        m["detections"][0]["label"] in m["caption"] for m in with_detections
     )
+    assert all(m["image"] is None or m["image"].startswith("data:image/jpeg") for m in server.sent)
+    assert any(dict(map(tuple, m["status"]))["pursuing"] != "-" for m in server.sent)
+
+
+#: The page's simulated time and the points plotly drew in each trace, read in one go (the
+#: stream may draw a new state between two reads).
+_SNAPSHOT = """() => ({t: Number(document.body.dataset.simTime ?? -1),
+  drawn: Object.fromEntries(document.getElementById('live-scene')._fullData
+    .map((trace) => [trace.meta.trace, trace._length ?? 0]))})"""
+
+
+def _snapshot_when(page, condition: str, arg: float = 0.0) -> dict:
+    """The first snapshot for which ``condition(snapshot, arg)`` holds (JS)."""
+    handle = page.wait_for_function(
+        f"a => (s => ({condition}) ? s : null)(({_SNAPSHOT})())", arg=arg, timeout=60_000
+    )
+    return handle.json_value()
 
 
 @pytest.mark.slow
@@ -182,19 +190,19 @@ def test_the_live_view_updates_in_a_browser(tmp_path: Path) -> None:
         runner = threading.Thread(target=mission)
         with open_page(server.url) as (page, errors):
             runner.start()
-            sim_time = "() => Number(document.body.dataset.simTime ?? -1)"
-            page.wait_for_function(f"() => ({sim_time})() > 0", timeout=60_000)
-            early_time, early = page.evaluate(sim_time), _drawn(page)
-            page.wait_for_function(f"t => ({sim_time})() > t + 20", arg=early_time, timeout=60_000)
+            early = _snapshot_when(page, "s.t > 0")
+            later = _snapshot_when(page, "s.t > a + 20", early["t"])
             page.wait_for_selector("text=mission completed", timeout=120_000)
-            final = _drawn(page)
+            final = page.evaluate(_SNAPSHOT)
             camera = page.get_attribute("#camera", "src")
             status = page.inner_text("#status")
             page.screenshot(path=str(tmp_path / "live.png"))
         runner.join(30)
     assert errors == []
-    assert early["world"] > 10  # the scene arrived first
-    assert final["path"] > early["path"] > 0 and final["map"] > 0
+    assert early["drawn"]["world"] > 10  # the scene arrived first
+    assert later["drawn"]["path"] > early["drawn"]["path"] > 0  # and the states updated it
+    early, final = early["drawn"], final["drawn"]
+    assert final["map"] > 0
     graph = load_graph(out / "graph.json")
     counts = Counter(n.layer.value.capitalize() for n in graph.nodes() if n.id != "robot")
     assert {layer: final[layer] for layer in LAYERS} == {layer: counts[layer] for layer in LAYERS}

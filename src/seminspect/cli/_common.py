@@ -93,3 +93,44 @@ def existing_outputs(run_dir: Path, names: Sequence[str]) -> list[str]:
     named = [name for name in names if (run_dir / name).exists()]
     pictures = len(list(run_dir.glob("*.png")))
     return named + ([f"{pictures} pictures (*.png)"] if pictures else ["no pictures"])
+
+
+#: The longest a command with ``--view`` waits for a browser before it starts the run anyway.
+VIEW_WAIT_S = 60.0
+
+
+def view_options(what: str, note: str = "") -> tuple[bool, int]:
+    """The ``--view`` and ``--view-port`` options of a command whose run can be watched live
+    (``note``: what else the help should say)."""
+    view = typer.Option(
+        False,
+        "--view",
+        help=f"Watch {what} live in a browser: a page on localhost (its address is printed); "
+        f"the run waits up to {VIEW_WAIT_S:.0f} s for the page to be opened{note}.",
+    )
+    port = typer.Option(
+        8765, "--view-port", help="Port of --view on localhost (0: any free one).", min=0,
+        max=65535,
+    )  # fmt: skip
+    return view, port
+
+
+def open_live_view(page: str, port: int):
+    """A live view's server for ``page``, once a browser has opened it (or after
+    :data:`VIEW_WAIT_S`): a short run would otherwise be over before anyone could look. A
+    port in use is one clear line."""
+    from seminspect.report.live_server import LiveServer
+
+    server = LiveServer(page, port)
+    err_console.print(
+        f"live view at {server.url}: open it in a browser (the run starts when it is open, or "
+        f"in {VIEW_WAIT_S:.0f} s)",
+        highlight=False,
+        soft_wrap=True,
+    )
+    try:
+        server.wait_for_client(VIEW_WAIT_S)
+    except BaseException:
+        server.close()
+        raise
+    return server

@@ -2,15 +2,24 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import typer
 
-from seminspect.cli._common import console, existing_outputs, progress_bar
+from seminspect.cli._common import (
+    console,
+    existing_outputs,
+    open_live_view,
+    progress_bar,
+    view_options,
+)
 
 if TYPE_CHECKING:
     from seminspect.missions.learning.env_config import EnvConfig, TargetShape
+    from seminspect.missions.learning.live import LiveWatch
 
 app = typer.Typer(no_args_is_help=True, help="Learned semantic inspection in rooms (004).")
 
@@ -26,6 +35,7 @@ _POLICY = typer.Option(
 _SEED = typer.Option(0, "--seed", help="Seed of the rooms, noise and random policy.", min=0)
 _ENVS = typer.Option(64, "--envs", help="Rooms stepped together.", min=1, max=512)
 _THREADS = typer.Option(1, "--threads", help="Ray-casting threads.", min=1, max=64)
+_VIEW, _VIEW_PORT = view_options("the episode", ", then flies it in real time")
 
 
 def parse_obstacles(text: str) -> list[int]:
@@ -219,35 +229,44 @@ def show_command(
     obstacles: int = typer.Option(9, "--obstacles", help="Obstacles in the room.", min=0, max=60),
     seed: int = _SEED,
     out: Path = typer.Option(..., "--out", "-o", help="Directory for the episode's PNGs."),
+    view: bool = _VIEW,
+    view_port: int = _VIEW_PORT,
 ) -> None:
     """Fly one recorded episode in the rooms the policy was trained in and draw it (top-down,
     3D, coverage against time)."""
     from seminspect.cli._common import writable_directory
-    from seminspect.missions.learning.env import InspectionVectorEnv
-    from seminspect.missions.learning.evaluation import EpisodeTrace
+    from seminspect.missions.learning.live import CRASHED, play_episode
     from seminspect.report.rl import write_episode_pictures
 
     writable_directory(out)
     controller = controller_for(policy, seed)
     config = env_config_for(controller).model_copy(update={"obstacles": obstacles})
-    env = InspectionVectorEnv(1, config, seed=seed, autoreset=False, record=True)
-    obs, _ = env.reset(seed=seed)
-    controller.reset(env)
-    crashed = False
-    with progress_bar() as bar:
+    with _watched(view, view_port) as watch, progress_bar() as bar:
         task = bar.add_task("episode", total=config.steps_per_episode)
-        for _ in range(config.steps_per_episode):
-            obs, _, crash, _, _ = env.step(controller.act(env, obs))
-            crashed = bool(crash[0])
-            if crashed:
-                break
-            bar.advance(task)
-    trace = EpisodeTrace(env.rooms[0], env.track(0), env.face_distances(0), crashed)
+        flown = play_episode(
+            controller, config, seed, watch=watch,
+            progress=lambda step: bar.update(task, completed=step),
+        )  # fmt: skip
     name = _policy_name(policy)
-    written = write_episode_pictures(trace, config, out, title=f"{name}, {obstacles} obstacles")
-    ending = "crashed" if crashed else "timeout (no crash)"
-    console.print(f"coverage {100.0 * env.coverage()[0]:.1f} %, {ending}")
+    title = f"{name}, {obstacles} obstacles"
+    written = write_episode_pictures(flown.trace, config, out, title=title)
+    ending = "crashed" if flown.ending == CRASHED else "timeout (no crash)"
+    console.print(f"coverage {100.0 * flown.coverage:.1f} %, {ending}")
     console.print(f"pictures: {', '.join(str(p) for p in written)}")
+
+
+@contextmanager
+def _watched(view: bool, port: int) -> Iterator[LiveWatch | None]:
+    """The live view's watch for ``--view`` (None without it); its server closes after the
+    episode."""
+    if not view:
+        yield None
+        return
+    from seminspect.missions.learning.live import LiveWatch
+    from seminspect.report.live_rl import EpisodeFeed, episode_page
+
+    with open_live_view(episode_page("seminspect rl show (live)"), port) as server:
+        yield LiveWatch(EpisodeFeed(server), real_time=True)
 
 
 def env_config_for(controller: object) -> EnvConfig:

@@ -3,11 +3,25 @@
 from __future__ import annotations
 
 import signal
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
-from seminspect.cli._common import console, existing_outputs, exit_stopped, labelled, progress_bar
+from seminspect.cli._common import (
+    console,
+    existing_outputs,
+    exit_stopped,
+    labelled,
+    open_live_view,
+    progress_bar,
+    view_options,
+)
+
+if TYPE_CHECKING:
+    from seminspect.missions.routine.live import LiveWatch
 
 app = typer.Typer(no_args_is_help=True, help="Routine inspection on an outdated map (002).")
 
@@ -31,6 +45,7 @@ _HISTORICAL = typer.Option(
 _CURRENT = typer.Option(
     None, "--current", help="Your own site as it is now (same layout as --historical)."
 )
+_VIEW, _VIEW_PORT = view_options("the inspection", " (one run: not with --compare)")
 
 
 def _config_and_site(world, scenario, seed, length, historical, current, *, need_current=True):
@@ -99,6 +114,8 @@ def inspect_command(
     ),
     out: Path = typer.Option(..., "--out", "-o", help="Run directory."),
     pictures: bool = typer.Option(True, "--pictures/--no-pictures", help="Draw the pictures."),
+    view: bool = _VIEW,
+    view_port: int = _VIEW_PORT,
 ) -> None:
     """Inspect the scenario's regions in the current world with a plan made on M_H."""
     from seminspect.missions.routine.run import PRIOR_FILE, run_routine
@@ -106,13 +123,20 @@ def inspect_command(
     from seminspect.report.html import write_routine_comparison_report, write_routine_report
     from seminspect.report.routine import comparison_figure, render_routine
 
+    if view and compare:
+        from seminspect.core.errors import InvalidInputError
+
+        raise InvalidInputError(
+            "--view watches one run: leave out --compare (or watch --adapt and --no-adapt "
+            "one at a time)"
+        )
     base, site = _config_and_site(world, scenario, seed, length, historical, current)
     if prior is None and base.world == "map":
         prior = Path(world)  # the map is M_H too: nothing to record
     runs = {"adaptive": True, "baseline": False} if compare else {"": adapt}
     results = {}
     shared_prior = prior
-    with progress_bar() as bar:
+    with _watched(view, view_port) as watch, progress_bar() as bar:
         for name, adaptive in runs.items():
             task = bar.add_task(name or "inspection", total=1.0)
 
@@ -122,8 +146,9 @@ def inspect_command(
             config = base.model_copy(update={"adapt": adaptive})
             run_dir = out / name if name else out
             result = run_routine(
-                config, run_dir, prior_path=shared_prior, tasks_path=tasks, progress=show, site=site
-            )
+                config, run_dir, prior_path=shared_prior, tasks_path=tasks, progress=show,
+                site=site, watch=watch,
+            )  # fmt: skip
             results[name] = result
             if shared_prior is None and (run_dir / PRIOR_FILE).exists():
                 shared_prior = run_dir / PRIOR_FILE  # the baseline plans on the same M_H
@@ -144,6 +169,19 @@ def inspect_command(
     stopped = [r for r in results.values() if r.state == "interrupted"]
     if stopped:
         exit_stopped(stopped[0].stop_signal, out)
+
+
+@contextmanager
+def _watched(view: bool, port: int) -> Iterator[LiveWatch | None]:
+    """The live view's watch for ``--view`` (None without it); its server closes after the run."""
+    if not view:
+        yield None
+        return
+    from seminspect.missions.routine.live import LiveWatch
+    from seminspect.report.live_routine import RoutineFeed, routine_page
+
+    with open_live_view(routine_page("seminspect routine inspect (live)"), port) as server:
+        yield LiveWatch(RoutineFeed(server))
 
 
 def _print_result(name: str, result) -> None:

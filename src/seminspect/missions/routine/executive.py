@@ -31,7 +31,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -126,8 +126,35 @@ class TaskRecord:
         return self.end_t - self.start_t
 
 
+@dataclass
+class ActiveTask:
+    """The task being worked on, for a watcher: its views (in visiting order once the tour is
+    made), each one's outcome (True tracked, False unreachable, None not yet) and its
+    region's coverage (None until the tour starts)."""
+
+    index: int
+    views: NDArray[np.float64]
+    outcomes: list[bool | None]
+    coverage: RegionCoverage | None = None
+
+
+class RoutineWatch(Protocol):
+    """Something that looks at a routine mission while it runs (the live view). It only reads,
+    so a watched mission makes the same decisions as one nobody watches."""
+
+    def step(self, frame: Frame | None) -> None:
+        """The robot has sensed again: ``frame`` is the view just taken and recorded; None after
+        a leg of driving or a view given up."""
+        ...
+
+
 class RoutineMission:
-    """Algorithm 1 over a site pair with a prior map (module docstring)."""
+    """Algorithm 1 over a site pair with a prior map (module docstring).
+
+    ``phase`` (``start``, ``navigate``, ``tour``, ``done``), ``active``, ``frame`` and ``watch``
+    are there for a watcher (:mod:`~seminspect.missions.routine.live`); the mission never reads
+    them.
+    """
 
     def __init__(
         self,
@@ -158,6 +185,10 @@ class RoutineMission:
             TaskRecord(p.region.name, len(p.positions), p.repaired, p.dropped) for p in self.plans
         ]
         self._cloud = np.empty((0, 3))
+        self.phase = "start"
+        self.active: ActiveTask | None = None
+        self.frame: Frame | None = None  # the last view's camera frame
+        self.watch: RoutineWatch | None = None
 
     # ----------------------------------------------------------------- set-up
     def _global_plan(self, region: InspectionRegion) -> ViewPlan:
@@ -190,6 +221,7 @@ class RoutineMission:
             chosen, route = selected
             pending.remove(chosen)
             self._run_task(chosen, route)
+        self.phase = "done"
         done = sum(t.completed for t in self.tasks)
         return f"{done} of {len(self.tasks)} tasks completed"
 
@@ -217,14 +249,21 @@ class RoutineMission:
 
     def _run_task(self, index: int, route: NDArray[np.float64]) -> None:
         plan, record = self.plans[index], self.tasks[index]
+        self.phase = "navigate"
+        self.active = ActiveTask(index, plan.positions, [None] * len(plan.positions))
         self._navigate(route)
         record.start_t = self.robot.time
         order = self._visiting_tour(plan, record)
         positions, yaws = plan.positions[order], plan.yaws[order]
         coverage = RegionCoverage(region_samples(plan.region, self.world, plan.normal))
+        self.phase = "tour"
+        self.active = active = ActiveTask(index, positions, [None] * len(order), coverage)
         for k in range(len(order)):
             segment = slice(k, k + self.config.horizon)
-            if self._track(plan, positions[segment], yaws[segment], k, coverage):
+            tracked = self._track(plan, positions[segment], yaws[segment], k, coverage)
+            active.outcomes[k] = tracked
+            self._show(self.frame if tracked else None)
+            if tracked:
                 record.views_tracked += 1
             if self.progress is not None:
                 self.progress(plan.region.name, (k + 1) / len(order))
@@ -294,6 +333,7 @@ class RoutineMission:
         coverage.add(frame, self.view.d_view, RANGE_TOLERANCE_M)
         self._cloud = sense(self.robot, self.world, self.current_map)
         self.samples.append(self._sample(plan, k, decision, frame))
+        self.frame = frame
         return True
 
     def _sample(self, plan: ViewPlan, k: int, decision: CycleDecision, frame: Frame) -> ViewSample:
@@ -362,8 +402,10 @@ class RoutineMission:
                 if result.blocked:
                     self._event("collision", at=np.round(result.position, 3).tolist())
                     self._cloud = sense(self.robot, self.world, self.current_map)
+                    self._show()
                     return "collided"
                 self._cloud = sense(self.robot, self.world, self.current_map)
+                self._show()
         return "reached"
 
     def _navigate(self, route: NDArray[np.float64]) -> None:
@@ -371,6 +413,10 @@ class RoutineMission:
         for checkpoint in _checkpoints(route, self.config.segment_m):
             if not self._go_to(checkpoint):
                 self._event("segment-end-skipped", at=np.round(checkpoint, 3).tolist())
+
+    def _show(self, frame: Frame | None = None) -> None:
+        if self.watch is not None:
+            self.watch.step(frame)
 
     # ----------------------------------------------------------------- results
     @property

@@ -34,6 +34,7 @@ from seminspect.core.io import atomic_write_text, write_versioned_json
 from seminspect.mapping.voxel import VoxelMap, save_map
 from seminspect.missions.routine.config import RoutineConfig
 from seminspect.missions.routine.executive import RoutineMission, samples_table
+from seminspect.missions.routine.live import LiveWatch
 from seminspect.missions.routine.measures import region_change
 from seminspect.missions.routine.metrics import (
     METRICS_FORMAT,
@@ -115,10 +116,12 @@ def run_routine(
     tasks_path: str | os.PathLike[str] | None = None,
     progress: Callable[[str, float], None] | None = None,
     site: SitePair | None = None,
+    watch: LiveWatch | None = None,
 ) -> RoutineResult:
     """``routine inspect``: record or load ``M_H``, run Algorithm 1, write the run directory.
 
-    ``site`` replaces the config's built-in site (a user pair, ``routine_sites.user_site``).
+    ``site`` replaces the config's built-in site (a user pair, ``routine_sites.user_site``);
+    ``watch``, when given, is shown the mission live from its first move (after ``M_H``).
     The directory is claimed as a mission's is (a lock, the code that ran, a heartbeat), and
     Ctrl-C or SIGTERM still leave every output gathered so far with a truthful status.
     """
@@ -136,7 +139,9 @@ def run_routine(
         with run.claimed(settings):
             if given is not None and Path(prior_path or "").suffix.lower() != ".npz":
                 save_map(run.path(PRIOR_FILE), given)  # the grid M_C is compared with
-            return _run_routine(run, config, site, regions, prior=given, progress=progress)
+            return _run_routine(
+                run, config, site, regions, prior=given, progress=progress, watch=watch
+            )
 
 
 def _run_routine(
@@ -147,6 +152,7 @@ def _run_routine(
     *,
     prior: VoxelMap | None,
     progress: Callable[[str, float], None] | None,
+    watch: LiveWatch | None,
 ) -> RoutineResult:
     started = time.perf_counter()
     mission: RoutineMission | None = None
@@ -156,6 +162,8 @@ def _run_routine(
         nonlocal mission
         historical = prior if prior is not None else _record_prior(config, site, run, progress)
         mission = RoutineMission(config, site, historical, regions, progress)
+        if watch is not None:
+            watch.attach(mission)
         return mission.execute()
 
     def write_outputs(end: RunEnd) -> None:
@@ -166,6 +174,8 @@ def _run_routine(
             _write_outputs(run, mission, metrics)
 
     end = conduct_run(run, work, write_outputs, expected=ROUTINE_LAYOUT.outputs, what="routine run")
+    if watch is not None:
+        watch.publish(ended=end.state, reason=end.reason)
     return RoutineResult(run.root, end.state, end.reason, metrics, end.signum)
 
 

@@ -18,8 +18,10 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from seminspect.core.errors import InvalidInputError
 from seminspect.graphs.lsg.graph import LayeredSemanticGraph
 from seminspect.mapping.voxel import VoxelMap
+from seminspect.missions.xflie.config import MissionConfig
 from seminspect.missions.xflie.executive import XFlie
 from seminspect.planning.utility import UtilityTerms
 from seminspect.sensors import Detection, Frame
@@ -73,6 +75,12 @@ class LiveFeed(Protocol):
     def publish(self, state: LiveState) -> None:
         """Take a state, reading the graph and the map before returning."""
         ...
+
+
+def refuse_unwatchable(config: MissionConfig) -> None:
+    """One clear error for a mission the live view cannot show (a team: it shows one robot)."""
+    if config.robots:
+        raise InvalidInputError("the live view shows one robot; a team cannot be watched yet")
 
 
 class LiveWatch:

@@ -14,7 +14,6 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Sequence
 
-from seminspect.core.errors import InvalidInputError
 from seminspect.core.interrupts import stop_on_signals
 from seminspect.missions.xflie import MissionProgress
 from seminspect.missions.xflie.build import build_mission, run_name
@@ -26,7 +25,7 @@ from seminspect.missions.xflie.config import (
 )
 from seminspect.missions.xflie.figures import mission_metrics
 from seminspect.missions.xflie.layout import OUTPUT_FILES, XFLIE_LAYOUT
-from seminspect.missions.xflie.live import LiveWatch
+from seminspect.missions.xflie.live import LiveWatch, refuse_unwatchable
 from seminspect.missions.xflie.metrics import CpuMeter, MissionMetrics, QueryAnswer
 from seminspect.missions.xflie.outputs import MissionResult, save_outputs, write_graph_first
 from seminspect.missions.xflie.queries import answer_queries
@@ -56,8 +55,8 @@ def run_mission(
     claimed (see :meth:`RunDirectory.claimed`): a second run on it fails at once, and files of an
     earlier run in it are removed. Ctrl-C and SIGTERM end the mission as ``interrupted``.
     """
-    if watch is not None and config.robots:
-        raise InvalidInputError("the live view shows one robot; a team cannot be watched yet")
+    if watch is not None:
+        refuse_unwatchable(config)
     world = open_world(config.world, default_scenario(config), seed=config.seed)
     config = resolve(config, world)
     with stop_on_signals():
