@@ -180,7 +180,8 @@ def test_a_team_cannot_be_watched(capsys, tmp_path) -> None:
 
 
 @pytest.mark.slow
-def test_view_prints_its_address_and_changes_no_output(capsys, tmp_path) -> None:
+def test_view_prints_its_address_and_changes_no_output(capsys, tmp_path, monkeypatch) -> None:
+    monkeypatch.setattr("seminspect.cli._common.VIEW_WAIT_S", 0.5)  # no browser comes
     args = ("--world", "campus", "--scenario", "small", "--budget", "60", "--no-pictures")
     code, _, _ = run(capsys, "mission", *args, "--out", str(tmp_path / "plain"))
     assert code == 0
@@ -191,3 +192,24 @@ def test_view_prints_its_address_and_changes_no_output(capsys, tmp_path) -> None
     assert "live view at http://127.0.0.1:" in err
     for name in ("graph.json", "trajectory.csv", "events.jsonl"):
         assert (tmp_path / "seen" / name).read_bytes() == (tmp_path / "plain" / name).read_bytes()
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (("--detector", "model.pt"), "expected 'truth' or an ONNX model file"),
+        (("--detector", "model.onnx"), "needs --class-map"),
+        (("--class-map", "classes.json"), "--class-map goes with an ONNX --detector"),
+        (("--detector", "missing.onnx", "--class-map", "classes.json"), "missing.onnx"),
+    ],
+)
+def test_a_detector_that_cannot_be_used_is_one_line_before_the_mission(
+    capsys, tmp_path, args, message
+) -> None:
+    (tmp_path / "classes.json").write_text('{"instance": {"0": "car"}}', encoding="utf-8")
+    out = tmp_path / "run"
+    resolved = [str(tmp_path / a) if a.endswith((".json", ".onnx")) else a for a in args]
+    code, _, err = run(capsys, "mission", *resolved, "--out", str(out))
+    assert code != 0 and message in err and "Traceback" not in err
+    assert err.strip().count("\n") == 0
+    assert not out.exists()

@@ -8,6 +8,7 @@ from seminspect.core.errors import InvalidInputError
 from seminspect.core.rng import make_rng
 from seminspect.geometry.transforms import quat_from_yaw
 from seminspect.sensors import CameraModel, Detection, Frame, TruthDetector, detect, render
+from seminspect.sensors.detector import reads_image
 from seminspect.sensors.noise import noise_preset
 from seminspect.sensors.segmentation import Level, as_level
 from seminspect.worlds import WorldBuilder
@@ -80,3 +81,24 @@ def test_a_mission_sees_through_the_detector_it_is_given() -> None:
     with pytest.raises(InvalidInputError, match="'instance' or 'part'"):
         mission.platform.detect(frame, "pixel", ["car"])
     assert counting.calls == 1
+
+
+class _Reading(_Counting):
+    """A detector that reads the image, as a model does."""
+
+    name = "reading"
+    reads_image = True
+
+
+def test_a_detector_that_reads_images_gets_them_in_every_frame() -> None:
+    from seminspect.missions.xflie.build import build_mission
+    from seminspect.missions.xflie.config import make_config, resolve
+
+    config = resolve(make_config({"world": "campus", "scenario": "small", "seed": 0}))
+    default, world = build_mission(config, None)
+    truth = TruthDetector(world, noise_preset("ideal"), make_rng(0, "test"))
+    assert not reads_image(truth) and not reads_image(_Counting(truth))
+    assert default.platform.capture(intensity=False).intensity is None  # the cheaper frame
+    reading, _ = build_mission(config, None, world=world, detector=_Reading(truth))
+    assert reads_image(reading.platform.detector)
+    assert reading.platform.capture(intensity=False).intensity is not None

@@ -15,6 +15,8 @@ from seminspect.cli._common import (
     existing_outputs,
     exit_stopped,
     labelled,
+    open_live_view,
+    view_options,
     writable_directory,
 )
 
@@ -92,14 +94,19 @@ _RECORD_MCAP_OPTION = typer.Option(
     help="When the mission ends, write run.mcap into the run directory: its poses, LiDAR, "
     "camera, 3DLSG and events as ROS 2 messages, for Foxglove (File > Open local file).",
 )
-_VIEW_OPTION = typer.Option(
-    False,
-    "--view",
-    help="Watch the mission live in a browser: a page on localhost (its address is printed) "
-    "with the robot's path, its camera and detections, the map and the 3DLSG as they grow.",
+_VIEW_OPTION, _VIEW_PORT_OPTION = view_options("the mission")
+_DETECTOR_OPTION = typer.Option(
+    "truth",
+    "--detector",
+    help="What segments the camera's frames: truth (the simulator's labels with the noise "
+    "preset's faults) or an instance-segmentation model in ONNX with YOLOv8-seg's outputs "
+    "(a .onnx file; needs --class-map).",
 )
-_VIEW_PORT_OPTION = typer.Option(
-    8765, "--view-port", help="Port of --view on localhost (0: any free one).", min=0, max=65535
+_CLASS_MAP_OPTION = typer.Option(
+    None,
+    "--class-map",
+    help="With an ONNX --detector: the JSON file naming each model class as a seminspect "
+    'label ({"instance": {"0": "car"}, "part": {...}, "ignore": [...]}).',
 )
 _FEATURES_OPTION = typer.Option(
     None,
@@ -135,6 +142,8 @@ def app(
     features: str | None = _FEATURES_OPTION,
     view: bool = _VIEW_OPTION,
     view_port: int = _VIEW_PORT_OPTION,
+    detector: str = _DETECTOR_OPTION,
+    class_map: Path | None = _CLASS_MAP_OPTION,
 ) -> None:
     """Explore a site, inspect every target level by level and build its 3DLSG (paper 000).
 
@@ -161,8 +170,13 @@ def app(
         )  # fmt: skip
         if out is not None:
             writable_directory(out)
+    if view:
+        from seminspect.missions.xflie.live import refuse_unwatchable
+
+        refuse_unwatchable(config)  # before waiting for a browser
+    model = _detector(detector, class_map)
     with _live_view(view_port) if view else contextlib.nullcontext() as server:
-        result = _run_with_progress(config, out, query, server)
+        result = _run_with_progress(config, out, query, server, model)
     if pictures and result.stop_signal != signal.SIGTERM:  # SIGTERM asks to stop now
         _draw_pictures(result.run_dir)
     if bag is not None and result.state == "completed":
@@ -220,17 +234,34 @@ def _resumed(ctx: typer.Context, run_dir: Path):
     return config, run_dir
 
 
+def _detector(choice: str, class_map: Path | None):
+    """None for the simulator's labels, else the user's ONNX model (refused in one line before
+    the mission when it or its class map is wrong)."""
+    from seminspect.core.errors import InvalidInputError
+
+    if choice == "truth":
+        if class_map is not None:
+            raise InvalidInputError("--class-map goes with an ONNX --detector, not with truth")
+        return None
+    if Path(choice).suffix.lower() != ".onnx":
+        raise InvalidInputError(
+            f"--detector {choice}: expected 'truth' or an ONNX model file (*.onnx)"
+        )
+    if class_map is None:
+        raise InvalidInputError(f"--detector {choice} needs --class-map (its classes' labels)")
+    from seminspect.perception.yolo_seg import YoloSegDetector
+
+    return YoloSegDetector.load(choice, class_map)
+
+
 def _live_view(port: int):
-    """The live view's server, its address printed (a port in use: one clear line)."""
+    """The live view's server, once a browser has it open (see :func:`open_live_view`)."""
     from seminspect.report.live_mission import live_page
-    from seminspect.report.live_server import LiveServer
 
-    server = LiveServer(live_page("seminspect mission (live)"), port)
-    err_console.print(f"live view at {server.url} (open it in a browser)", highlight=False)
-    return server
+    return open_live_view(live_page("seminspect mission (live)"), port)
 
 
-def _run_with_progress(config, out: Path | None, queries: list[str], server=None):
+def _run_with_progress(config, out: Path | None, queries: list[str], server=None, detector=None):
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from seminspect.missions.xflie.live import LiveWatch
@@ -261,7 +292,9 @@ def _run_with_progress(config, out: Path | None, queries: list[str], server=None
                 inspected=progress.inspected,
             )
 
-        return run_mission(config, out, queries=queries, progress=show, watch=watch)
+        return run_mission(
+            config, out, queries=queries, progress=show, watch=watch, detector=detector
+        )
 
 
 def _draw_pictures(run_dir: Path) -> None:

@@ -1,4 +1,5 @@
-"""Perception: from sensor frames to semantic observations (detection, localisation, similarity)."""
+"""Perception: from sensor frames to semantic observations (detection, localisation, similarity),
+and a detector of the user's own (a YOLOv8-seg model in ONNX)."""
 
 from seminspect.perception.detections import detection_points, observe
 from seminspect.perception.encoders import (
@@ -10,13 +11,16 @@ from seminspect.perception.encoders import (
 )
 from seminspect.perception.observation import Observation
 from seminspect.perception.similarity import SceneMatcher, scene_similarity
+from seminspect.perception.yolo_seg import ClassMap, YoloSegDetector
 
 __all__ = [
     "Calibration",
+    "ClassMap",
     "Encoder",
     "Observation",
     "SceneMatcher",
     "TextEncoder",
+    "YoloSegDetector",
     "detection_points",
     "make_encoder",
     "observe",

@@ -22,7 +22,7 @@ from seminspect.platform.protocol import Motion
 from seminspect.robot import Robot
 from seminspect.robot.robot import MoveResult
 from seminspect.sensors import CameraModel, Detection, Frame, Lidar, LidarScan, render
-from seminspect.sensors.detector import Detector, TruthDetector
+from seminspect.sensors.detector import Detector, TruthDetector, reads_image
 from seminspect.sensors.noise import NoiseModel, NormalStream, make_noise
 from seminspect.sensors.segmentation import as_level
 from seminspect.worlds import World
@@ -164,7 +164,8 @@ class SimulatedPlatform:
 
     # ----------------------------------------------------------------- sensing
     def capture(self, intensity: bool = True) -> Frame:
-        """Stop, then take one 640x480 depth + segmentation (+ intensity) frame."""
+        """Stop, then take one 640x480 depth + segmentation (+ intensity) frame; always with
+        its intensity when the detector reads images (it sees every frame the program does)."""
         if self.settle_s:
             self.robot.wait(self.settle_s)
         late, now = self.robot.sensor_poses(self.noise.image_time_offset_s)
@@ -178,7 +179,7 @@ class SimulatedPlatform:
             stamp=now.time,
             odometry=(now.odometry_position, self._camera_quaternion(now.odometry_yaw)),
             threads=self.threads,
-            intensity=intensity,
+            intensity=intensity or reads_image(self.detector),
         )
         self.robot.wait(self.capture_s)
         self.frames += 1

@@ -26,6 +26,7 @@ from seminspect.core.errors import InvalidInputError
 from seminspect.core.params import InspectionParams
 from seminspect.core.threads import rotate_rows, run_dealt
 from seminspect.geometry.transforms import Quat, Vec3, as_point, as_quaternion
+from seminspect.sensors.appearance import Appearance, colour_image
 from seminspect.sensors.noise import NoiseModel, NormalStream, require_rng
 from seminspect.sensors.shading import OCTAVE_WEIGHTS, OCTAVES, shade_hits, surface_tables
 from seminspect.worlds import World
@@ -122,6 +123,9 @@ class Frame:
         camera: the camera model (its scaled version for strided renders).
         odometry_position, odometry_orientation: the pose the robot believed it had at
             ``stamp``; equal to the true pose unless the caller passes odometry.
+        rgb: ``uint8`` (H, W, 3) colour image under an
+            :class:`~seminspect.sensors.appearance.Appearance`, without noise; None unless
+            rendered with one (``render(..., appearance=...)``).
     """
 
     depth: NDArray[np.float32]
@@ -136,6 +140,7 @@ class Frame:
     camera: CameraModel
     odometry_position: Vec3 = field(default=None)  # type: ignore[arg-type]
     odometry_orientation: Quat = field(default=None)  # type: ignore[arg-type]
+    rgb: NDArray[np.uint8] | None = None
 
     def __post_init__(self) -> None:
         if self.odometry_position is None:
@@ -229,6 +234,7 @@ def render(
     odometry: tuple[ArrayLike, ArrayLike] | None = None,
     threads: int = 1,
     intensity: bool = True,
+    appearance: Appearance | None = None,
 ) -> Frame:
     """Render a frame of ``world`` from the camera pose ``(position, orientation [x,y,z,w])``.
 
@@ -243,6 +249,9 @@ def render(
         intensity: shade the intensity image; False leaves it out (``Frame.intensity`` None)
             for a caller that reads only depth and labels. The noise draws the same deviates
             either way, so a seeded run's depth noise does not depend on it.
+        appearance: also render the colour image under it (``Frame.rgb``, ideal: its noise
+            is the caller's, :func:`~seminspect.sensors.appearance.add_colour_noise`); the
+            other images and the noise draws are the same with or without it.
     """
     origin = as_point(position, "camera position")
     quat = as_quaternion(orientation, "camera orientation")
@@ -252,6 +261,11 @@ def render(
         world, model, origin, (directions, distance, face), threads=threads, intensity=intensity
     )
     shape = (model.height, model.width)
+    colour = (
+        None
+        if appearance is None
+        else colour_image(appearance, world, origin, (directions, distance, face), 1.0 / model.fx)
+    )
     frame = Frame(
         depth=depth.reshape(shape),
         instance=instance.reshape(shape),
@@ -269,6 +283,7 @@ def render(
         odometry_orientation=quat
         if odometry is None
         else as_quaternion(odometry[1], "odometry orientation"),
+        rgb=None if colour is None else colour.reshape((*shape, 3)),
     )
     if noise is not None and not noise.is_ideal:
         _add_image_noise(frame, noise, rng if isinstance(rng, NormalStream) else require_rng(rng))

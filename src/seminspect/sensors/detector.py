@@ -5,7 +5,9 @@ A detector segments a frame into objects (``level="instance"``, by class) or the
 detector; :class:`TruthDetector`, the default, reads the simulator's per-pixel labels and puts
 them through the fault model of :class:`~seminspect.sensors.noise.NoiseModel`
 (:func:`~seminspect.sensors.segmentation.detect`). A detector that reads pixels uses the
-frame's image, depth and camera model only.
+frame's image, depth and camera model only, and says so with a true ``reads_image``
+(:func:`reads_image`): a platform then renders the image of every frame, including those a
+program asks for without it.
 """
 
 from __future__ import annotations
@@ -33,6 +35,13 @@ class Detector(Protocol):
     def detect(self, frame: Frame, level: Level, labels: Sequence[str]) -> list[Detection]:
         """The detections of ``labels`` (classes for objects, part names for parts)."""
         ...
+
+
+def reads_image(detector: Detector) -> bool:
+    """Whether ``detector`` reads the frame's image (a model does; the simulator's labels do
+    not): an optional ``reads_image`` attribute, False when absent, so that any detector
+    without it keeps the cheaper frames."""
+    return bool(getattr(detector, "reads_image", False))
 
 
 @dataclass(eq=False)

@@ -98,14 +98,14 @@ def shade_hits(  # noqa: PLR0917 - a compiled kernel takes its arrays positional
         b = plane_axes[f, 1]
         u = origin[a] + t * directions[i, a]
         v = origin[b] + t * directions[i, b]
-        texture = _texture(
+        texture = texture_value(
             u, v, 2.0 * t * pixel_angle, plane_seed[f], octaves, weights, last_cell, last_value
         )
         intensity[i] = _grey_level(albedo[f], light[f], texture)
 
 
 @numba.njit(cache=True, inline="always")
-def _texture(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
+def texture_value(  # noqa: PLR0917 - a compiled kernel takes its arrays positionally
     u: float,
     v: float,
     footprint: float,
