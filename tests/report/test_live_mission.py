@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import base64
 import json
-import threading
 from collections import Counter
 from pathlib import Path
 
@@ -13,12 +12,12 @@ import cv2
 import numpy as np
 import pytest
 
+from live_pages import grew, watch_in_browser
 from seminspect.graphs.lsg.io import load_graph
 from seminspect.mapping.voxel import OCCUPIED, VoxelMap
 from seminspect.missions.xflie.config import make_config
 from seminspect.missions.xflie.live import LiveWatch
 from seminspect.missions.xflie.run import run_mission
-from seminspect.report.browser import find_chromium, open_page
 from seminspect.report.live_common import MAX_MAP_POINTS, camera_picture, occupied_points
 from seminspect.report.live_mission import LAYERS as LAYER_TRACES
 from seminspect.report.live_mission import MissionFeed, graph_traces, live_page
@@ -159,54 +158,24 @@ def test_messages_are_the_mission_as_it_stood(feed_messages) -> None:
     assert any(dict(map(tuple, m["status"]))["pursuing"] != "-" for m in server.sent)
 
 
-#: The page's simulated time and the points plotly drew in each trace, read in one go (the
-#: stream may draw a new state between two reads).
-_SNAPSHOT = """() => ({t: Number(document.body.dataset.simTime ?? -1),
-  drawn: Object.fromEntries(document.getElementById('live-scene')._fullData
-    .map((trace) => [trace.meta.trace, trace._length ?? 0]))})"""
-
-
-def _snapshot_when(page, condition: str, arg: float = 0.0) -> dict:
-    """The first snapshot for which ``condition(snapshot, arg)`` holds (JS)."""
-    handle = page.wait_for_function(
-        f"a => (s => ({condition}) ? s : null)(({_SNAPSHOT})())", arg=arg, timeout=60_000
-    )
-    return handle.json_value()
-
-
 @pytest.mark.slow
 def test_the_live_view_updates_in_a_browser(tmp_path: Path) -> None:
-    if find_chromium() is None:
-        pytest.skip("no Chromium found (apt-get install chromium, or set $SEMINSPECT_CHROMIUM)")
-    pytest.importorskip("playwright.sync_api", reason="playwright is not installed")
     config = make_config({"world": "campus", "scenario": "small", "seed": 0, "time_budget_s": 200})
     out = tmp_path / "run"
-    with LiveServer(live_page("live test"), port=0, period_s=0.2) as server:
 
-        def mission() -> None:
-            if server.wait_for_client(60):
-                run_mission(config, out, watch=LiveWatch(MissionFeed(server)))
+    def mission(server: LiveServer) -> None:
+        run_mission(config, out, watch=LiveWatch(MissionFeed(server)))
 
-        runner = threading.Thread(target=mission)
-        with open_page(server.url) as (page, errors):
-            runner.start()
-            early = _snapshot_when(page, "s.t > 0")
-            later = _snapshot_when(page, "s.t > a + 20", early["t"])
-            page.wait_for_selector("text=mission completed", timeout=120_000)
-            final = page.evaluate(_SNAPSHOT)
-            camera = page.get_attribute("#camera", "src")
-            status = page.inner_text("#status")
-            page.screenshot(path=str(tmp_path / "live.png"))
-        runner.join(30)
-    assert errors == []
-    assert early["drawn"]["world"] > 10  # the scene arrived first
-    assert later["drawn"]["path"] > early["drawn"]["path"] > 0  # and the states updated it
-    early, final = early["drawn"], final["drawn"]
-    assert final["map"] > 0
+    page = live_page("live test")
+    seen = watch_in_browser(page, mission, "mission completed", tmp_path / "live.png")
+    final = seen.final
+    assert seen.errors == []
+    assert final["world"] > 10 and final["map"] > 0
+    assert grew(seen.states) and seen.states[-1][1] == final["path"]
     graph = load_graph(out / "graph.json")
     counts = Counter(n.layer.value.capitalize() for n in graph.nodes() if n.id != "robot")
     assert {layer: final[layer] for layer in LAYERS} == {layer: counts[layer] for layer in LAYERS}
-    assert final["Target"] >= early["Target"] and final["Target"] > 0
-    assert camera is not None and camera.startswith("data:image/jpeg;base64,")
-    assert "pursuing" in status and "completed" in status
+    assert final["Target"] > 0
+    assert seen.camera is not None and seen.camera.startswith("data:image/jpeg;base64,")
+    assert "pursuing" in seen.status and "completed" in seen.status
     assert (tmp_path / "live.png").stat().st_size > 20_000

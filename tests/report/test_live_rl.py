@@ -4,17 +4,16 @@ browser the page fills and updates while an episode is flown and ends with its o
 from __future__ import annotations
 
 import json
-import threading
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from live_pages import grew, watch_in_browser
 from seminspect.missions.learning.baselines import OrbitController, RandomController
 from seminspect.missions.learning.env_config import EnvConfig
 from seminspect.missions.learning.live import EpisodeRun, LiveWatch, play_episode
 from seminspect.missions.learning.rooms import TARGET_FACES
-from seminspect.report.browser import find_chromium, open_page
 from seminspect.report.live_rl import (
     COVERED,
     FAR,
@@ -107,63 +106,29 @@ def test_a_crash_says_what_it_struck() -> None:
     assert server.sent[-1]["final"].startswith("episode crashed: struck the ")
 
 
-def _drawn(page) -> dict[str, int]:
-    """Points in each trace of the live scene (a mesh's vertices)."""
-    return page.evaluate(
-        "() => Object.fromEntries(document.getElementById('live-scene').data"
-        ".map((t) => [t.meta.trace, t.x.length]))"
-    )
-
-
-#: Keeps (step, points of the path) of every state the page draws, in ``window.drawn``.
-RECORD_STATES = """() => {
-  window.drawn = [];
-  const gd = document.getElementById('live-scene');
-  new MutationObserver(() => window.drawn.push([Number(document.body.dataset.simTime),
-      gd.data.find((t) => t.meta.trace === 'path').x.length]))
-    .observe(document.body, {attributes: true, attributeFilter: ['data-sim-time']});
-}"""
-
-
 @pytest.mark.slow
 def test_the_live_view_updates_in_a_browser(tmp_path: Path) -> None:
-    if find_chromium() is None:
-        pytest.skip("no Chromium found (apt-get install chromium, or set $SEMINSPECT_CHROMIUM)")
-    pytest.importorskip("playwright.sync_api", reason="playwright is not installed")
     config = EnvConfig(obstacles=4, episode_seconds=30.0)
     flown: list[EpisodeRun] = []
-    with LiveServer(episode_page("live test"), port=0, period_s=0.2) as server:
 
-        def episode() -> None:
-            if server.wait_for_client(60):
-                watch = LiveWatch(EpisodeFeed(server))
-                flown.append(play_episode(OrbitController(), config, seed=2, watch=watch))
+    def episode(server: LiveServer) -> None:
+        watch = LiveWatch(EpisodeFeed(server))
+        flown.append(play_episode(OrbitController(), config, seed=2, watch=watch))
 
-        runner = threading.Thread(target=episode)
-        with open_page(server.url) as (page, errors):
-            page.evaluate(RECORD_STATES)
-            runner.start()
-            page.wait_for_selector("text=episode timeout", timeout=60_000)
-            final = _drawn(page)
-            drawn = page.evaluate("() => window.drawn")
-            colours = page.evaluate(
-                f"() => document.getElementById('live-scene').data[{TRACES.index('faces')}]"
-                ".marker.color"
-            )
-            camera = page.get_attribute("#camera", "src")
-            status = page.inner_text("#status")
-            page.screenshot(path=str(tmp_path / "live.png"))
-        runner.join(30)
-    assert errors == []
+    colours_js = f"() => document.getElementById('live-scene').data[{TRACES.index('faces')}]"
+    seen = watch_in_browser(
+        episode_page("live test"), episode, "episode timeout", tmp_path / "live.png",
+        {"colours": colours_js + ".marker.color"},
+    )  # fmt: skip
+    final, colours, times = seen.final, seen.values["colours"], [t for t, _ in seen.states]
+    assert seen.errors == []
     assert flown and flown[0].ending == "timeout"
     assert set(final) == set(TRACES)
     assert final["room"] > 10 and final["obstacles"] > 0 and final["object"] > 0
     assert final["faces"] == TARGET_FACES and final["robot"] == 1
-    times, paths = zip(*drawn, strict=True)
-    assert len(drawn) >= 3 and list(times) == sorted(times) and times[0] < times[-1]
-    assert list(paths) == sorted(paths) and paths[0] < paths[-1] == len(flown[0].trace.track)
+    assert grew(seen.states) and seen.states[-1][1] == len(flown[0].trace.track)
     assert isinstance(colours, list) and colours.count(STRICT) == int(flown[0].strict.sum())
     assert np.isclose(times[-1], config.episode_seconds)
-    assert camera is not None and camera.startswith("data:image/jpeg;base64,")
-    assert "strict" in status and "timeout" in status
+    assert seen.camera is not None and seen.camera.startswith("data:image/jpeg;base64,")
+    assert "strict" in seen.status and "timeout" in seen.status
     assert (tmp_path / "live.png").stat().st_size > 20_000

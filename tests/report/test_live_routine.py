@@ -5,17 +5,16 @@ from __future__ import annotations
 
 import csv
 import json
-import threading
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from live_pages import grew, watch_in_browser
 from seminspect.mapping.voxel import VoxelMap
 from seminspect.missions.routine.config import RoutineConfig
 from seminspect.missions.routine.live import ActiveView, LiveState, LiveWatch
 from seminspect.missions.routine.run import RoutineResult, run_routine
-from seminspect.report.browser import find_chromium, open_page
 from seminspect.report.live_common import MAX_MAP_POINTS
 from seminspect.report.live_routine import (
     PENDING,
@@ -135,66 +134,30 @@ def test_the_tour_shows_each_views_outcome() -> None:
     json.dumps(ended, allow_nan=False)
 
 
-def _drawn(page) -> dict[str, int]:
-    """Points plotly drew in each trace of the live scene."""
-    return page.evaluate(
-        "() => Object.fromEntries(document.getElementById('live-scene')._fullData"
-        ".map((t) => [t.meta.trace, t._length ?? 0]))"
-    )
-
-
-#: Keeps (simulated time, points of the path) of every state the page draws, in
-#: ``window.drawn``: a fast run is over before a test could poll it state by state.
-RECORD_STATES = """() => {
-  window.drawn = [];
-  const gd = document.getElementById('live-scene');
-  new MutationObserver(() => window.drawn.push([Number(document.body.dataset.simTime),
-      gd._fullData.find((t) => t.meta.trace === 'path')._length ?? 0]))
-    .observe(document.body, {attributes: true, attributeFilter: ['data-sim-time']});
-}"""
-
-
 @pytest.mark.slow
 def test_the_live_view_updates_in_a_browser(tmp_path: Path) -> None:
-    if find_chromium() is None:
-        pytest.skip("no Chromium found (apt-get install chromium, or set $SEMINSPECT_CHROMIUM)")
-    pytest.importorskip("playwright.sync_api", reason="playwright is not installed")
     out = tmp_path / "run"
     results: list[RoutineResult] = []
-    with LiveServer(routine_page("live test"), port=0, period_s=0.2) as server:
 
-        def mission() -> None:
-            if server.wait_for_client(60):
-                feed = RoutineFeed(server)
-                results.append(run_routine(RoutineConfig(**SMALL), out, watch=LiveWatch(feed)))
+    def mission(server: LiveServer) -> None:
+        feed = RoutineFeed(server)
+        results.append(run_routine(RoutineConfig(**SMALL), out, watch=LiveWatch(feed)))
 
-        runner = threading.Thread(target=mission)
-        with open_page(server.url) as (page, errors):
-            page.evaluate(RECORD_STATES)
-            runner.start()
-            page.wait_for_selector("text=run completed", timeout=60_000)
-            final = _drawn(page)
-            drawn = page.evaluate("() => window.drawn")
-            tour_colours = page.evaluate(
-                f"() => document.getElementById('live-scene').data[{TRACES.index('tour')}]"
-                ".marker.color"
-            )
-            camera = page.get_attribute("#camera", "src")
-            status = page.inner_text("#status")
-            page.screenshot(path=str(tmp_path / "live.png"))
-        runner.join(30)
-    assert errors == []
+    tour_js = f"() => document.getElementById('live-scene').data[{TRACES.index('tour')}]"
+    seen = watch_in_browser(
+        routine_page("live test"), mission, "run completed", tmp_path / "live.png",
+        {"tour": tour_js + ".marker.color"},
+    )  # fmt: skip
+    final = seen.final
+    assert seen.errors == []
     assert results and results[0].state == "completed"
     assert set(final) == set(TRACES)
     assert final["M_H"] > 100 and final["planned views"] > 0 and final["regions"] > 0
-    # the page drew several states, the clock and the path only ever moving on
-    times, paths = zip(*drawn, strict=True)
-    assert len(drawn) >= 3 and list(times) == sorted(times) and times[0] < times[-1]
-    assert list(paths) == sorted(paths) and 0 < paths[0] < paths[-1] == final["path"]
+    assert grew(seen.states) and seen.states[-1][1] == final["path"]
     assert final["M_C"] > 0 and final["robot"] == 1
     views = len(_views(out))
     assert final["tour"] == final["views flown"] == views
-    assert tour_colours == [TRACKED] * views
-    assert camera is not None and camera.startswith("data:image/jpeg;base64,")
-    assert "ROI coverage" in status and "completed" in status
+    assert seen.values["tour"] == [TRACKED] * views
+    assert seen.camera is not None and seen.camera.startswith("data:image/jpeg;base64,")
+    assert "ROI coverage" in seen.status and "completed" in seen.status
     assert (tmp_path / "live.png").stat().st_size > 20_000
