@@ -198,7 +198,7 @@ def test_view_prints_its_address_and_changes_no_output(capsys, tmp_path, monkeyp
     ("args", "message"),
     [
         (("--detector", "model.pt"), "expected 'truth' or an ONNX model file"),
-        (("--detector", "model.onnx"), "needs --class-map"),
+        (("--detector", "model.onnx"), "model.onnx"),
         (("--class-map", "classes.json"), "--class-map goes with an ONNX --detector"),
         (("--detector", "missing.onnx", "--class-map", "classes.json"), "missing.onnx"),
     ],

@@ -41,6 +41,12 @@ GROUPS: tuple[tuple[str, str, str], ...] = (
     ("bench", "bench", "Studies that reproduce the papers' comparisons (planning: 000 Table 5)."),
     ("sweep", "sweep", "Many missions (worlds x scenarios x seeds x settings) on Ray, one table."),
     ("rl", "rl", "Learned semantic inspection in rooms: evaluate and show (paper 004)."),
+    (
+        "perception",
+        "perception",
+        "Detectors from pixels: render a labelled dataset, train a segmentation network "
+        "(000 Sec III).",
+    ),
     ("plan", "plan", "A volumetric path between two points on a map file (.bt, .npz, .ply, .pcd)."),
     ("view", "view", "Open a run's report.html (3D graph, tables, plots) in the browser."),
 )

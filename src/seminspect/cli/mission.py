@@ -99,8 +99,8 @@ _DETECTOR_OPTION = typer.Option(
     "truth",
     "--detector",
     help="What segments the camera's frames: truth (the simulator's labels with the noise "
-    "preset's faults) or an instance-segmentation model in ONNX with YOLOv8-seg's outputs "
-    "(a .onnx file; needs --class-map).",
+    "preset's faults), a model 'seminspect perception export' wrote (.onnx), or an "
+    "instance-segmentation model in ONNX with YOLOv8-seg's outputs (.onnx with --class-map).",
 )
 _CLASS_MAP_OPTION = typer.Option(
     None,
@@ -247,8 +247,10 @@ def _detector(choice: str, class_map: Path | None):
         raise InvalidInputError(
             f"--detector {choice}: expected 'truth' or an ONNX model file (*.onnx)"
         )
-    if class_map is None:
-        raise InvalidInputError(f"--detector {choice} needs --class-map (its classes' labels)")
+    if class_map is None:  # seminspect's own export carries its labels
+        from seminspect.perception.learned import LearnedDetector
+
+        return LearnedDetector.load(choice)
     from seminspect.perception.yolo_seg import YoloSegDetector
 
     return YoloSegDetector.load(choice, class_map)

@@ -1,5 +1,6 @@
 """Perception: from sensor frames to semantic observations (detection, localisation, similarity),
-and a detector of the user's own (a YOLOv8-seg model in ONNX)."""
+a detector of the user's own (a YOLOv8-seg model in ONNX) and the learned detector trained here
+(its ONNX export; training it needs torch: ``perception.training``)."""
 
 from seminspect.perception.detections import detection_points, observe
 from seminspect.perception.encoders import (
@@ -9,6 +10,7 @@ from seminspect.perception.encoders import (
     make_encoder,
     register_encoder,
 )
+from seminspect.perception.learned import LearnedDetector
 from seminspect.perception.observation import Observation
 from seminspect.perception.similarity import SceneMatcher, scene_similarity
 from seminspect.perception.yolo_seg import ClassMap, YoloSegDetector
@@ -17,6 +19,7 @@ __all__ = [
     "Calibration",
     "ClassMap",
     "Encoder",
+    "LearnedDetector",
     "Observation",
     "SceneMatcher",
     "TextEncoder",

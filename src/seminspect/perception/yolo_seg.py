@@ -219,6 +219,13 @@ class ModelLayout:
 
 def open_session(path: Path, threads: int | None = None) -> tuple[Any, ModelLayout]:
     """An onnxruntime CPU session of the model file at ``path``, and its checked layout."""
+    session = open_onnx_session(path, threads)
+    return session, model_layout(session, path.name)
+
+
+def open_onnx_session(path: Path, threads: int | None = None) -> Any:
+    """An onnxruntime CPU session of any ONNX file at ``path``; a missing or broken file is a
+    one-line :class:`FileFormatError` (shared with :mod:`.learned`)."""
     if not path.is_file():
         raise FileFormatError(f"{path}: no such model file")
     import onnxruntime  # noqa: PLC0415 - 0.15 s to import, paid by runs that use a model only
@@ -234,7 +241,7 @@ def open_session(path: Path, threads: int | None = None) -> tuple[Any, ModelLayo
     except Exception as exc:  # onnxruntime has a type for every way a file can be broken
         reason = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
         raise FileFormatError(f"{path}: not an ONNX model onnxruntime can run ({reason})") from None
-    return session, model_layout(session, path.name)
+    return session
 
 
 def model_layout(session: Any, source: str) -> ModelLayout:
@@ -384,7 +391,9 @@ class YoloSegDetector:
                 continue
             scores = row[4 : 4 + classes]
             label, level = self.class_map.classes[int(np.argmax(scores))]
-            found.append(_detection(label, level, min(float(scores.max()), 1.0), window, frame))
+            found.append(
+                window_detection(label, level, min(float(scores.max()), 1.0), window, frame)
+            )
         return found
 
 
@@ -433,7 +442,7 @@ def _frame_mask(
     return (inside, x0, y0) if inside.any() else None
 
 
-def _detection(
+def window_detection(
     label: str,
     level: Level,
     score: float,
