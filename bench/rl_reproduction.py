@@ -107,6 +107,7 @@ RETRAINED_RUNS = {
     "v3-no-gru": "v3, no GRU (2.0 M steps)",
     "v3-gru-512": "v3, GRU 512 (2.0 M steps)",
     "v4-tune": "v4: v3 fine-tuned with the contact penalty (1.0 M steps)",
+    "v4-main": "v4 (5.0 M steps)",
 }
 EVALUATIONS |= {
     run: (CHECKPOINTS / run / "checkpoint.pt", (ABLATION_OBSTACLES,), label, "cylinder")

@@ -48,6 +48,7 @@ NEEDS = {
         "v3-no-gru",
         "v3-gru-512",
         "v4-tune",
+        "v4-main",
         "table1-orbit",
     ),
 }
