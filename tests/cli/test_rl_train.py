@@ -53,6 +53,7 @@ def test_a_new_run_needs_out(capsys) -> None:
 
 def test_show_flies_the_rooms_of_the_policy_checkpoint(capsys, tmp_path, monkeypatch) -> None:
     import seminspect.missions.learning.env as env_module
+    import seminspect.missions.learning.live as live_module
 
     rooms = EnvConfig(room_size=(5.0, 5.0, 3.0), target_shapes=("sphere",), episode_seconds=0.5)
     torch.manual_seed(0)
@@ -65,7 +66,7 @@ def test_show_flies_the_rooms_of_the_policy_checkpoint(capsys, tmp_path, monkeyp
             seen.append(config)
             super().__init__(num_envs, config, **options)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(env_module, "InspectionVectorEnv", Spied)
+    monkeypatch.setattr(live_module, "InspectionVectorEnv", Spied)  # where rl show flies
     out = tmp_path / "show"
     code, _, err = run(capsys, "rl", "show", "-p", str(path), "--obstacles", "2", "-o", str(out))
     assert code == 0, err
