@@ -15,7 +15,6 @@ import pickle
 import tempfile
 import warnings
 import zipfile
-import zlib
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +23,7 @@ import torch
 
 from seminspect.core.errors import FileFormatError, InvalidInputError
 from seminspect.core.io import atomic_write_bytes, atomic_write_with
+from seminspect.core.torch_files import check_archive, unreadable
 from seminspect.perception.learned import (
     INPUT_NAME,
     METADATA_KEYS,
@@ -92,22 +92,11 @@ def _net(payload: dict[str, Any], source: Path, key: str) -> SegNet:
 def _load(source: Path, kind: str, what: str) -> dict[str, Any]:
     if not source.is_file():
         raise FileFormatError(f"{source}: no such file, expected a {what}")
+    check_archive(source, what, "copy the file again or train again")
     try:
-        with zipfile.ZipFile(source) as archive:
-            damaged = archive.testzip()
-        if damaged is not None:
-            raise FileFormatError(f"{source}: damaged {what} ({damaged} fails its CRC check)")
         payload = torch.load(source, map_location="cpu", weights_only=True)
-    except (
-        pickle.UnpicklingError,
-        RuntimeError,
-        EOFError,
-        ValueError,
-        zipfile.BadZipFile,
-        zlib.error,
-    ) as exc:
-        first = (str(exc).splitlines() or [type(exc).__name__])[0]
-        raise FileFormatError(f"{source}: not a readable {what} ({first})") from None
+    except (pickle.UnpicklingError, RuntimeError, EOFError, ValueError, zipfile.BadZipFile) as exc:
+        raise unreadable(source, what, exc) from None
     if not isinstance(payload, dict) or payload.get("format") != kind:
         raise FileFormatError(f"{source}: not a {kind} file")
     if payload.get("version") != FILE_VERSION:

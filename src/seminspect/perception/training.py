@@ -23,13 +23,11 @@ loss sums, so ``resume=True`` continues bit for bit: the same steps, the same we
 
 from __future__ import annotations
 
-import contextlib
 import csv
 import dataclasses
 import io
 import math
 import time
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -41,6 +39,7 @@ from seminspect.core.errors import InvalidInputError
 from seminspect.core.interrupts import deferred_signals, stop_on_signals
 from seminspect.core.io import atomic_write_text
 from seminspect.core.rng import make_rng
+from seminspect.core.torch_files import torch_threads
 from seminspect.perception.segnet import DEFAULT_CHANNELS, SegNet, SegNetConfig
 from seminspect.perception.segnet_io import (
     CHECKPOINT_NAME,
@@ -290,7 +289,7 @@ def train_detector(
     config = DetectorTraining(steps=steps, batch=batch, lr=lr, seed=seed, **settings)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    with _torch_threads(config.threads):
+    with torch_threads(config.threads):
         data = load_data(dataset_dir, config.val_fraction)
         run = _resumed(out, data, config) if resume else _fresh(data, config)
         return _drive(run, out, max_minutes, stop_at)
@@ -312,16 +311,6 @@ def _resumed(out: Path, data: DetectorData, config: DetectorTraining) -> _Run:
     if state.get("dataset") != data.fingerprint:
         raise InvalidInputError(f"{source}: the run was trained on another dataset")
     return _Run.restored(state, data, source)
-
-
-@contextlib.contextmanager
-def _torch_threads(count: int) -> Iterator[None]:
-    threads = torch.get_num_threads()
-    torch.set_num_threads(count)
-    try:
-        yield
-    finally:
-        torch.set_num_threads(threads)
 
 
 def _drive(run: _Run, out: Path, max_minutes: float | None, stop_at: int | None) -> TrainResult:

@@ -15,7 +15,6 @@ from __future__ import annotations
 import dataclasses
 import pickle
 import zipfile
-import zlib
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +23,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from seminspect.core.errors import FileFormatError
 from seminspect.core.io import atomic_write_with
+from seminspect.core.torch_files import check_archive, unreadable
 from seminspect.core.validation import describe_validation_error
 from seminspect.missions.learning.env_config import EnvConfig
 from seminspect.missions.learning.policy import InspectionPolicy, PolicyConfig
@@ -126,23 +126,6 @@ def read_checkpoint(path: str | Path) -> Checkpoint:
         ) from None
     policy.eval()
     return Checkpoint(policy, policy_config, train_config, declared.steps, env_config)
-
-
-def check_archive(source: Path, kind: str, remedy: str) -> None:
-    """Refuse a ``torch.save`` archive with a member whose bytes no longer match their CRC."""
-    try:
-        with zipfile.ZipFile(source) as archive:
-            damaged = archive.testzip()
-    except (zipfile.BadZipFile, zlib.error, EOFError, NotImplementedError) as exc:
-        raise unreadable(source, kind, exc) from None
-    if damaged is not None:
-        raise FileFormatError(f"{source}: damaged {kind} ({damaged} fails its CRC check); {remedy}")
-
-
-def unreadable(source: Path, kind: str, exc: Exception) -> FileFormatError:
-    """The one-line error of a file ``torch.load`` could not read."""
-    first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-    return FileFormatError(f"{source}: not a readable {kind} ({first})")
 
 
 def load_policy(path: str | Path) -> InspectionPolicy:

@@ -33,11 +33,10 @@ waits for the update under way to end) and continued bit for bit.
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import math
 import time
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Protocol
 
@@ -48,6 +47,7 @@ from torch import Tensor
 from seminspect.core.errors import InvalidInputError
 from seminspect.core.interrupts import deferred_signals, stop_on_signals
 from seminspect.core.rng import make_rng
+from seminspect.core.torch_files import torch_threads
 from seminspect.missions.learning.checkpoints import CHECKPOINT_NAME, save_checkpoint
 from seminspect.missions.learning.env_config import EnvConfig
 from seminspect.missions.learning.policy import (
@@ -324,7 +324,7 @@ def train(
         )
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    with _torch_threads(train_config.threads):
+    with torch_threads(train_config.threads):
         torch.manual_seed(_torch_seed(train_config.seed, "init"))
         policy = InspectionPolicy(policy_config).to(device)
         if initial is not None:
@@ -346,19 +346,9 @@ def resume(
     """Continue the run ``state`` saved (:func:`~.training_state.read_training_state` of
     ``out_dir``), as if it had never stopped; ``progress.csv`` goes on from its rows."""
     out = Path(out_dir)
-    with _torch_threads(state.train_config.threads):
+    with torch_threads(state.train_config.threads):
         run = _Run.restored(state)
         return _drive(run, out, ProgressLog(out, state.rows), progress, stop_after_s)
-
-
-@contextlib.contextmanager
-def _torch_threads(count: int) -> Iterator[None]:
-    threads = torch.get_num_threads()
-    torch.set_num_threads(count)
-    try:
-        yield
-    finally:
-        torch.set_num_threads(threads)
 
 
 def _drive(

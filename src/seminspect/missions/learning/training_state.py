@@ -24,8 +24,8 @@ from pydantic import ValidationError
 
 from seminspect.core.errors import FileFormatError
 from seminspect.core.io import atomic_write_with
+from seminspect.core.torch_files import check_archive, unreadable
 from seminspect.core.validation import describe_validation_error
-from seminspect.missions.learning.checkpoints import check_archive, unreadable
 from seminspect.missions.learning.env_config import EnvConfig
 from seminspect.missions.learning.policy import PolicyConfig
 from seminspect.missions.learning.progress import ProgressRow
