@@ -18,7 +18,7 @@ def test_a_damaged_member_fails_its_crc(tmp_path: Path) -> None:
     raw = bytearray(path.read_bytes())
     raw[raw.index(b"0123456789") + 5] ^= 0xFF  # one flipped byte inside the member
     path.write_bytes(bytes(raw))
-    with pytest.raises(FileFormatError, match=r"data/0 fails its CRC check); train again"):
+    with pytest.raises(FileFormatError, match=r"data/0 fails its CRC check\); train again"):
         check_archive(path, "checkpoint", "train again")
 
 
