@@ -7,6 +7,7 @@ a run that is over in seconds is still seen state by state.
 
 from __future__ import annotations
 
+import json
 import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -29,6 +30,29 @@ RECORD_STATES = """() => {
 #: Points plotly drew in each trace of the scene (a mesh's vertices).
 DRAWN = """() => Object.fromEntries(document.getElementById('live-scene')._fullData
   .map((t) => [t.meta.trace, t._length ?? t.x?.length ?? 0]))"""
+
+
+class RecordingServer:
+    """What a feed needs of a live server, keeping what was sent as the page would parse it:
+    the scene, the states (``sent``) and the other events' messages (``events``)."""
+
+    def __init__(self) -> None:
+        self.scene: dict | None = None
+        self.sent: list[dict] = []
+        self.events: dict[str, list[dict]] = {}
+
+    def ready(self) -> bool:
+        return True
+
+    def set_scene(self, scene: dict) -> None:
+        self.scene = json.loads(json.dumps(scene, allow_nan=False))
+
+    def send(self, message: dict, event: str = "message") -> None:
+        parsed = json.loads(json.dumps(message, allow_nan=False))
+        if event == "message":
+            self.sent.append(parsed)
+        else:
+            self.events.setdefault(event, []).append(parsed)
 
 
 @dataclass

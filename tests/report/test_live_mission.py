@@ -4,7 +4,6 @@ the page fills and updates while a mission runs and ends with the mission's fina
 from __future__ import annotations
 
 import base64
-import json
 from collections import Counter
 from pathlib import Path
 
@@ -12,7 +11,7 @@ import cv2
 import numpy as np
 import pytest
 
-from live_pages import grew, watch_in_browser
+from live_pages import RecordingServer, grew, watch_in_browser
 from seminspect.graphs.lsg.io import load_graph
 from seminspect.mapping.voxel import OCCUPIED, VoxelMap
 from seminspect.missions.xflie.config import make_config
@@ -26,26 +25,6 @@ from seminspect.sensors import CameraModel, Detection, Frame
 
 LAYERS = ("Feature", "Pose", "Level", "Target")
 assert LAYER_TRACES == LAYERS  # the page's trace names are the layers' own
-
-
-class _Server:
-    """What a feed needs of a server, keeping what was sent."""
-
-    def __init__(self) -> None:
-        self.scene: dict | None = None
-        self.sent: list[dict] = []
-        self.maps: list[dict] = []
-
-    def ready(self) -> bool:
-        return True
-
-    def set_scene(self, scene: dict) -> None:
-        self.scene = scene
-
-    def send(self, message: dict, event: str = "message") -> None:
-        kept = self.sent if event == "message" else self.maps
-        assert event in {"message", "traces"}
-        kept.append(json.loads(json.dumps(message, allow_nan=False)))
 
 
 def _frame(intensity: bool) -> Frame:
@@ -124,8 +103,8 @@ def test_graph_traces_hold_every_node_and_edge(small_mission_dir: Path) -> None:
 
 
 @pytest.fixture(scope="module")
-def feed_messages(tmp_path_factory: pytest.TempPathFactory) -> tuple[_Server, Path]:
-    server = _Server()
+def feed_messages(tmp_path_factory: pytest.TempPathFactory) -> tuple[RecordingServer, Path]:
+    server = RecordingServer()
     out = tmp_path_factory.mktemp("live") / "run"
     config = make_config({"world": "campus", "scenario": "small", "seed": 0, "time_budget_s": 120})
     run_mission(config, out, watch=LiveWatch(MissionFeed(server)))  # type: ignore[arg-type]
@@ -148,8 +127,9 @@ def test_messages_are_the_mission_as_it_stood(feed_messages) -> None:
         layer: counts[layer] for layer in LAYERS
     }
     # the map goes on its own, at most every MAP_PERIOD_S, and once more at the end
-    assert 1 < len(server.maps) < len(server.sent) / 2
-    assert 0 < len(server.maps[-1]["traces"]["map"]["x"]) <= MAX_MAP_POINTS
+    assert set(server.events) == {"traces"}
+    assert 1 < len(server.events["traces"]) < len(server.sent) / 2
+    assert 0 < len(server.events["traces"][-1]["traces"]["map"]["x"]) <= MAX_MAP_POINTS
     with_detections = [m for m in server.sent if m["detections"]]
     assert with_detections and all(
         m["detections"][0]["label"] in m["caption"] for m in with_detections

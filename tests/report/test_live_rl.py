@@ -3,13 +3,12 @@ browser the page fills and updates while an episode is flown and ends with its o
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from live_pages import grew, watch_in_browser
+from live_pages import RecordingServer, grew, watch_in_browser
 from seminspect.missions.learning.baselines import OrbitController, RandomController
 from seminspect.missions.learning.env_config import EnvConfig
 from seminspect.missions.learning.live import EpisodeRun, LiveWatch, play_episode
@@ -28,26 +27,9 @@ SHORT = EnvConfig(obstacles=4, episode_seconds=8.0)
 TRACES = ("room", "obstacles", "object", "faces", "path", "robot")
 
 
-class _Server:
-    """What a feed needs of a server, keeping what was sent (as the page would parse it)."""
-
-    def __init__(self) -> None:
-        self.scene: dict | None = None
-        self.sent: list[dict] = []
-
-    def ready(self) -> bool:
-        return True
-
-    def set_scene(self, scene: dict) -> None:
-        self.scene = json.loads(json.dumps(scene, allow_nan=False))
-
-    def send(self, message: dict) -> None:
-        self.sent.append(json.loads(json.dumps(message, allow_nan=False)))
-
-
 @pytest.fixture(scope="module")
-def feed_messages() -> tuple[_Server, EpisodeRun]:
-    server = _Server()
+def feed_messages() -> tuple[RecordingServer, EpisodeRun]:
+    server = RecordingServer()
     feed = EpisodeFeed(server)  # type: ignore[arg-type]
     flown = play_episode(OrbitController(), SHORT, seed=2, watch=LiveWatch(feed))
     return server, flown
@@ -94,7 +76,7 @@ def test_messages_are_the_episode_as_it_stood(feed_messages) -> None:
 
 
 def test_a_crash_says_what_it_struck() -> None:
-    server = _Server()
+    server = RecordingServer()
     config = EnvConfig(obstacles=0, episode_seconds=30.0)
     flown = play_episode(
         RandomController(0),

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from live_pages import grew, watch_in_browser
+from live_pages import RecordingServer, grew, watch_in_browser
 from seminspect.mapping.voxel import VoxelMap
 from seminspect.missions.routine.config import RoutineConfig
 from seminspect.missions.routine.live import ActiveView, LiveState, LiveWatch
@@ -29,26 +29,9 @@ SMALL = {"scenario": "receding", "seed": 1, "length": 12.0}
 TRACES = ("M_H", "M_C", "regions", "planned views", "tour", "views flown", "path", "robot")
 
 
-class _Server:
-    """What a feed needs of a server, keeping what was sent (as the page would parse it)."""
-
-    def __init__(self) -> None:
-        self.scene: dict | None = None
-        self.sent: list[dict] = []
-
-    def ready(self) -> bool:
-        return True
-
-    def set_scene(self, scene: dict) -> None:
-        self.scene = json.loads(json.dumps(scene, allow_nan=False))
-
-    def send(self, message: dict) -> None:
-        self.sent.append(json.loads(json.dumps(message, allow_nan=False)))
-
-
 @pytest.fixture(scope="module")
-def feed_messages(tmp_path_factory: pytest.TempPathFactory) -> tuple[_Server, Path]:
-    server = _Server()
+def feed_messages(tmp_path_factory: pytest.TempPathFactory) -> tuple[RecordingServer, Path]:
+    server = RecordingServer()
     out = tmp_path_factory.mktemp("live") / "run"
     feed = RoutineFeed(server)  # type: ignore[arg-type]
     run_routine(RoutineConfig(**SMALL), out, watch=LiveWatch(feed))
@@ -120,7 +103,7 @@ def _state(outcomes: tuple[bool | None, ...], ended: str | None = None) -> LiveS
 
 
 def test_the_tour_shows_each_views_outcome() -> None:
-    feed = RoutineFeed(_Server())  # type: ignore[arg-type]
+    feed = RoutineFeed(RecordingServer())  # type: ignore[arg-type]
     message = feed.message(_state((True, False, None)))
     assert message["traces"]["tour"]["color"] == [TRACKED, UNREACHABLE, PENDING]
     assert "unreachable" in message["traces"]["tour"]["text"][1]
